@@ -1,0 +1,44 @@
+#include <algorithm>
+#include <exception>
+#include <iostream>
+
+#include <spdlog/spdlog.h>
+
+#include "ademono/core/error.h"
+#include "command.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ademono: monocular SLAM with metric depth, dynamic-object and distant-point filtering"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "ademono 0.1.0");
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
+      ->capture_default_str();
+
+  auto& commands = ademono::cli::Commands();
+  std::sort(commands.begin(), commands.end(),
+            [](const auto& a, const auto& b) { return a.name < b.name; });
+  std::vector<std::pair<CLI::App*, ademono::cli::Runner>> runners;
+  for (const auto& command : commands) {
+    CLI::App* sub = app.add_subcommand(command.name, command.description);
+    runners.emplace_back(sub, command.setup(*sub));
+  }
+
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::set_pattern("[%l] %v");
+
+  for (auto& [sub, runner] : runners) {
+    if (!sub->parsed()) continue;
+    try {
+      return runner();
+    } catch (const ademono::InputError& e) {
+      std::cerr << "ademono " << sub->get_name() << ": error: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "ademono " << sub->get_name() << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  return 1;
+}

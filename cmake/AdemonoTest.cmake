@@ -1,0 +1,16 @@
+# ademono_add_test(<name> SOURCES ... LIBS ...)
+# A GoogleTest executable whose tests CTest discovers. Tests find real data through
+# ADEMONO_SHARED_DIR (../shared beside the checkout), fixtures through ADEMONO_SOURCE_DIR and the
+# CLI through ADEMONO_CLI.
+function(ademono_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  get_filename_component(_shared "${PROJECT_SOURCE_DIR}/../shared" ABSOLUTE)
+  target_compile_definitions(${name} PRIVATE
+    ADEMONO_SHARED_DIR="${_shared}"
+    ADEMONO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    ADEMONO_CLI="$<TARGET_FILE:ademono_cli>")
+  add_dependencies(${name} ademono_cli)
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 900)
+endfunction()

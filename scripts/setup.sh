@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Installs what ademono needs on Debian 12, only what is missing, then configures and builds.
+# Usage: scripts/setup.sh [--build-type Release|Debug|Asan] [--build-dir DIR] [--no-build]
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_type=Release
+build_dir=""
+do_build=1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-type) build_type="$2"; shift 2 ;;
+    --build-dir) build_dir="$2"; shift 2 ;;
+    --no-build) do_build=0; shift ;;
+    *) echo "setup.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+[ -n "$build_dir" ] || build_dir="$here/build/$(echo "$build_type" | tr '[:upper:]' '[:lower:]')"
+
+apt_packages=(
+  build-essential cmake ninja-build pkg-config ccache
+  libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev
+  libspdlog-dev libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
+)
+missing=()
+for p in "${apt_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+# npm fetches ONNX Runtime; a machine may already have Node.js from elsewhere.
+command -v npm >/dev/null || missing+=(npm)
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=""; [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# ONNX Runtime 1.29 (CPU) from the npm registry into a project-local prefix.
+ort_root="$here/.deps/onnxruntime"
+if [ ! -f "$ort_root/lib/libonnxruntime.so.1" ] || [ ! -f "$ort_root/include/onnxruntime_cxx_api.h" ]; then
+  echo "setup: fetching ONNX Runtime (npm com.github.asus4.onnxruntime@0.4.9)"
+  tmp="$(mktemp -d)"
+  trap 'rm -rf "$tmp"' EXIT
+  (cd "$tmp" && npm pack --silent com.github.asus4.onnxruntime@0.4.9 >/dev/null)
+  tar -xzf "$tmp"/com.github.asus4.onnxruntime-0.4.9.tgz -C "$tmp"
+  hdr="$tmp/package/Plugins/iOS~/onnxruntime.xcframework/ios-arm64/onnxruntime.framework/Headers"
+  rm -rf "$ort_root.partial" && mkdir -p "$ort_root.partial/include" "$ort_root.partial/lib"
+  cp "$hdr"/*.h "$ort_root.partial/include/"
+  cp "$tmp/package/Plugins/Linux/x64/libonnxruntime.so" "$ort_root.partial/lib/libonnxruntime.so.1"
+  ln -sf libonnxruntime.so.1 "$ort_root.partial/lib/libonnxruntime.so"
+  rm -rf "$ort_root" && mv "$ort_root.partial" "$ort_root"
+fi
+
+if [ "$do_build" = 1 ]; then
+  launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+    -DONNXRUNTIME_ROOT="$ort_root" "${launcher[@]}" >/dev/null
+  cmake --build "$build_dir" -j "$(nproc)"
+fi

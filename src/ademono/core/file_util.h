@@ -1,0 +1,40 @@
+#pragma once
+// File helpers: whole-file reads, atomic writes (temp file + rename, so a failed run never leaves
+// half-written output), strict number parsing for text formats.
+
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace ademono {
+
+std::string ReadTextFile(const std::filesystem::path& path);
+
+// Writes through `write` into "<path>.tmp.<pid>" and renames it onto `path` on success.
+// Creates the parent directory. On any exception the temp file is removed and the error rethrown.
+void WriteFileAtomic(const std::filesystem::path& path,
+                     const std::function<void(std::ostream&)>& write);
+void WriteTextFileAtomic(const std::filesystem::path& path, std::string_view text);
+// cv::imwrite through a temp file with the same extension.
+void WriteImageAtomic(const std::filesystem::path& path, const cv::Mat& image);
+
+// Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing or does not decode.
+cv::Mat ReadImage(const std::filesystem::path& path, int flags);
+
+// Splits on whitespace (and commas when `commas` is true), dropping empty fields.
+std::vector<std::string_view> SplitFields(std::string_view line, bool commas = false);
+// Parses a finite double; InputError "path:line: field N 'text' is not a number" otherwise.
+double ParseDouble(std::string_view text, const std::filesystem::path& path, size_t line,
+                   size_t field_index);
+
+// Reads `path` line by line, skipping empty lines and lines starting with '#'.
+// Calls `on_line(line_number, fields)`.
+void ForEachDataLine(const std::filesystem::path& path, bool commas,
+                     const std::function<void(size_t, const std::vector<std::string_view>&)>& on_line);
+
+}  // namespace ademono
