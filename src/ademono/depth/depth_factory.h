@@ -1,0 +1,28 @@
+#pragma once
+// Builds a DepthProvider from its command-line spec:
+//   sensor                         the dataset's own depth (TUM, 7-Scenes, synthetic)
+//   cache:DIR                      precomputed maps: 16-bit PNG (mm) or 32-bit float TIFF (m),
+//                                  matched to frames by file-name stem or timestamp
+//   simulated[:k=v,...]            network-like errors applied to the dataset's depth (synth)
+//   model:FILE.onnx[,spec=Y.yaml]  a metric-depth ONNX model through ONNX Runtime
+// Throws InputError for an unknown kind or a bad argument (naming the file for cache/model).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "ademono/depth/depth_provider.h"
+#include "ademono/io/sequence.h"
+
+namespace ademono {
+
+struct DepthFactoryContext {
+  const Sequence* sequence = nullptr;  // for sensor/simulated checks; may be null
+  uint64_t seed = 0;                   // for providers with randomness (simulated)
+  int num_threads = 1;                 // inference threads (model)
+};
+
+std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
+                                                 const DepthFactoryContext& context);
+
+}  // namespace ademono
