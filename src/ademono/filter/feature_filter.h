@@ -1,0 +1,100 @@
+#pragma once
+// The method's three per-frame filters, applied in order to the ORB keypoints of a frame before
+// tracking: (1) depth-weighted feature enhancement, (2) dynamic interference removal,
+// (3) distant-point filtering. Each can be switched off (the paper's ablation).
+// Keypoints labelled anything but kKept are never used for pose estimation or as map points.
+
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "ademono/core/camera.h"
+#include "ademono/core/geometry.h"
+#include "ademono/detect/detection.h"
+
+namespace ademono {
+
+enum class PointLabel : uint8_t {
+  kKept = 0,
+  kEnhancementDropped,  // not chosen by the depth-weighted quadtree selection
+  kDynamicSmallBox,     // inside a grown small-target box
+  kDynamicStage1,       // large box, displacement differs from background by > D_dis
+  kDynamicStage2,       // large box, reprojection error under constant velocity > D_min
+  kDistantDropped,      // deeper than Z_th and drawn for dropping
+};
+const char* PointLabelName(PointLabel label);
+
+struct FilterOptions {
+  bool enable_enhancement = true;
+  bool enable_dynamic_removal = true;
+  bool enable_distant_filter = true;
+  // Enhancement: fraction of a block's points kept, quadtree depth (levels of 4-way split).
+  double enhancement_keep_ratio = 0.75;
+  int enhancement_levels = 2;
+  // P and Q (percent) scale the weight; documented in docs/filters.md.
+  double enhancement_p_percent = -1;  // < 0: derived from the image size
+  double enhancement_q_percent = -1;
+  // Dynamic removal.
+  double box_growth = 0.02;            // d = box_growth * box diagonal
+  double small_box_area_ratio = 0.05;  // box area / image area below this: drop all inside
+  int background_matches_t = 20;       // t smallest-Hamming background matches
+  double d_dis_px = 8.0;               // stage 1 threshold (pixels)
+  double d_min_px = 4.0;               // stage 2 threshold (pixels)
+  std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
+  // Distant filter.
+  double z_th_m = 30.0;
+  double drop_probability = 0.5;
+  uint64_t seed = 42;
+
+  void Check() const;  // throws std::invalid_argument
+  static FilterOptions FromYaml(const YAML::Node& node);  // the `filter:` sub-node
+};
+
+// What the filter needs of the previous frame for the two-stage dynamic test.
+struct PreviousFrameFeatures {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  // World position of each keypoint (from its depth and the frame's estimated pose); NaN if none.
+  std::vector<Eigen::Vector3d> points_world;
+};
+
+struct FilterInput {
+  const Camera* camera = nullptr;
+  const std::vector<cv::KeyPoint>* keypoints = nullptr;
+  const cv::Mat* descriptors = nullptr;
+  const std::vector<float>* depths = nullptr;  // metres per keypoint, <= 0 when unknown
+  const std::vector<Detection>* detections = nullptr;
+  const PreviousFrameFeatures* previous = nullptr;         // null on the first frame
+  std::optional<Rigid3d> predicted_cam_from_world;          // constant-velocity prediction
+};
+
+struct FilterStats {
+  int boxes_small = 0;
+  int boxes_large = 0;
+  int removed_enhancement = 0;
+  int removed_small_box = 0;
+  int removed_stage1 = 0;
+  int removed_stage2 = 0;
+  int removed_distant = 0;
+  int kept = 0;
+};
+
+class FeatureFilter {
+ public:
+  explicit FeatureFilter(const FilterOptions& options);
+  // One label per input keypoint. Deterministic given the options' seed and the call sequence.
+  std::vector<PointLabel> Apply(const FilterInput& input, FilterStats* stats = nullptr);
+  const FilterOptions& Options() const { return options_; }
+
+ private:
+  FilterOptions options_;
+  std::mt19937_64 rng_;
+};
+
+}  // namespace ademono
