@@ -1,0 +1,39 @@
+#include "ademono/depth/depth_factory.h"
+
+#include "ademono/core/error.h"
+#include "ademono/depth/cache_depth.h"
+#include "ademono/depth/sensor_depth.h"
+
+namespace ademono {
+namespace {
+
+[[noreturn]] void ThrowNotAvailable(const std::string& kind) {
+  throw InputError("depth provider '" + kind + "' is not available in this build");
+}
+
+}  // namespace
+
+std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
+                                                 const DepthFactoryContext& context) {
+  const size_t colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string argument = colon == std::string::npos ? "" : spec.substr(colon + 1);
+
+  if (kind == "sensor") {
+    if (!argument.empty()) throw InputError("depth provider 'sensor' takes no argument");
+    return std::make_unique<SensorDepthProvider>(context.sequence);
+  }
+  if (kind == "cache") {
+    if (argument.empty()) throw InputError("depth provider 'cache' needs a folder: cache:DIR");
+    return std::make_unique<CacheDepthProvider>(argument);
+  }
+  // --- simulated[:k=v,...] (engineer "synth" adds this branch) ---
+  if (kind == "simulated") ThrowNotAvailable(kind);
+  // --- model:FILE.onnx[,spec=Y.yaml] (engineer "onnx" adds this branch) ---
+  if (kind == "model") ThrowNotAvailable(kind);
+
+  throw InputError("unknown depth provider '" + spec +
+                   "' (expected sensor, cache:DIR, simulated[:k=v,...] or model:FILE.onnx)");
+}
+
+}  // namespace ademono

@@ -1,0 +1,49 @@
+#pragma once
+// Local bundle adjustment (ORB-SLAM's LocalBundleAdjustment) with Ceres: free keyframe poses and
+// points, fixed border keyframes, Huber loss, a first solve, outlier classification by chi2 (and
+// points behind the camera), then a second solve without the outliers. Single-threaded, with
+// parameter blocks added in the given order, so results are identical run to run.
+
+#include <cstdint>
+#include <vector>
+
+#include "ademono/optimize/optimizer_types.h"
+
+namespace ademono {
+
+struct BundleAdjustmentOptions {
+  int first_iterations = 5;
+  int second_iterations = 10;
+  void Check() const;  // throws std::invalid_argument
+};
+
+struct BaCamera {
+  Rigid3d cam_from_world = Rigid3d::Identity();
+  bool fixed = false;
+};
+
+struct BaObservation {
+  size_t camera = 0;  // index into cameras
+  size_t point = 0;   // index into points
+  ImageObservation image;
+};
+
+struct BundleAdjustmentProblem {
+  PinholeIntrinsics intrinsics;
+  std::vector<BaCamera> cameras;
+  std::vector<Eigen::Vector3d> points;  // world
+  std::vector<BaObservation> observations;
+};
+
+struct BundleAdjustmentResult {
+  std::vector<Rigid3d> cam_from_world;  // one per camera (fixed ones unchanged)
+  std::vector<Eigen::Vector3d> points;
+  std::vector<bool> outlier;  // one per observation, after the second solve
+  bool converged = false;
+};
+
+// Throws std::invalid_argument for indices out of range.
+BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& problem,
+                                             const BundleAdjustmentOptions& options = {});
+
+}  // namespace ademono

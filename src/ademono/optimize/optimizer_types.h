@@ -1,0 +1,36 @@
+#pragma once
+// Data passed to the Ceres optimisers. The optimisers know nothing about frames or maps: SLAM
+// copies what it needs into these structs (under the map lock), solves without the lock, and
+// writes results back.
+//
+// Observation model (ORB-SLAM2 RGB-D mode): a keypoint at undistorted pixel (u, v) with metric
+// depth z is treated as a virtual stereo measurement (u, v, u_right = u - bf / z), bf being a
+// virtual baseline times fx; without depth it is a plain (u, v) measurement. Residuals are scaled
+// by 1 / sigma of the keypoint's pyramid level, so chi2 thresholds are in pixels^2 at level 0.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ademono/core/geometry.h"
+
+namespace ademono {
+
+struct PinholeIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double bf = 0;  // virtual baseline (m) * fx, for the depth residual
+};
+
+struct ImageObservation {
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // undistorted
+  double u_right = -1.0;                            // < 0: no depth, 2-dof residual
+  double inv_sigma2 = 1.0;                          // 1 / sigma^2 of the keypoint's level
+  bool HasDepth() const { return u_right >= 0.0; }
+};
+
+// chi2 thresholds at 95%: 2 dof (u, v) and 3 dof (u, v, u_right).
+inline constexpr double kChi2Mono = 5.991;
+inline constexpr double kChi2Stereo = 7.815;
+
+}  // namespace ademono

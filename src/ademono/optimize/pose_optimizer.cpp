@@ -1,0 +1,76 @@
+#include "ademono/optimize/pose_optimizer.h"
+
+#include <stdexcept>
+
+#include "ademono/optimize/residuals.h"
+
+namespace ademono {
+
+void PoseOptimizerOptions::Check() const {
+  if (rounds < 1) throw std::invalid_argument("pose optimiser: rounds must be >= 1");
+  if (iterations_per_round < 1) {
+    throw std::invalid_argument("pose optimiser: iterations_per_round must be >= 1");
+  }
+}
+
+PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
+                                    const Rigid3d& initial_cam_from_world,
+                                    const std::vector<PoseObservation>& observations,
+                                    const PoseOptimizerOptions& options) {
+  options.Check();
+  PoseOptimizationResult result;
+  result.cam_from_world = initial_cam_from_world;
+  result.outlier.assign(observations.size(), false);
+  if (observations.empty()) return result;
+
+  double camera[6];
+  internal::RigidToParams(initial_cam_from_world, camera);
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.iterations_per_round;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+
+  for (int round = 0; round < options.rounds; ++round) {
+    // ORB-SLAM keeps the robust kernel for the first two rounds only: by then the outliers are
+    // out and the plain least squares gives the best estimate for the inliers.
+    const bool robust = round < 2 || options.robust_last_round;
+    ceres::Problem problem;
+    int added = 0;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      if (result.outlier[i]) continue;
+      const PoseObservation& o = observations[i];
+      if (o.image.HasDepth()) {
+        auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<3>, 3, 6>(
+            new internal::PoseOnlyResidual<3>(intrinsics, o.image, o.point_world));
+        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Stereo)) : nullptr,
+                                 camera);
+      } else {
+        auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<2>, 2, 6>(
+            new internal::PoseOnlyResidual<2>(intrinsics, o.image, o.point_world));
+        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Mono)) : nullptr,
+                                 camera);
+      }
+      ++added;
+    }
+    if (added < 3) break;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+
+    const Rigid3d pose = internal::ParamsToRigid(camera);
+    result.num_inliers = 0;
+    for (size_t i = 0; i < observations.size(); ++i) {
+      const PoseObservation& o = observations[i];
+      const double chi2 = internal::ObservationChi2(intrinsics, o.image, pose, o.point_world, nullptr);
+      result.outlier[i] = chi2 > (o.image.HasDepth() ? kChi2Stereo : kChi2Mono);
+      if (!result.outlier[i]) ++result.num_inliers;
+    }
+    if (result.num_inliers < 10) break;
+  }
+  result.cam_from_world = internal::ParamsToRigid(camera);
+  return result;
+}
+
+}  // namespace ademono

@@ -1,0 +1,39 @@
+#pragma once
+// Motion-only pose optimisation (ORB-SLAM's PoseOptimization) with Ceres: the camera pose is
+// refined against fixed 3D points, Huber loss (delta = sqrt(chi2 threshold)), 4 rounds with
+// outlier classification by chi2 after each round; outliers are left out of the next round and
+// may come back if they fit the refined pose. Single-threaded and deterministic.
+
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "ademono/optimize/optimizer_types.h"
+
+namespace ademono {
+
+struct PoseOptimizerOptions {
+  int rounds = 4;
+  int iterations_per_round = 10;
+  bool robust_last_round = false;  // ORB-SLAM drops the robust kernel in the last rounds
+  void Check() const;              // throws std::invalid_argument
+};
+
+struct PoseObservation {
+  Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
+  ImageObservation image;
+};
+
+struct PoseOptimizationResult {
+  Rigid3d cam_from_world = Rigid3d::Identity();
+  std::vector<bool> outlier;  // one per observation
+  int num_inliers = 0;
+};
+
+// `initial_cam_from_world` is the starting pose. With no observation it is returned unchanged.
+PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
+                                    const Rigid3d& initial_cam_from_world,
+                                    const std::vector<PoseObservation>& observations,
+                                    const PoseOptimizerOptions& options = {});
+
+}  // namespace ademono
