@@ -1,0 +1,173 @@
+#include "ademono/feature/matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace ademono {
+namespace {
+
+void CheckDescriptors(const cv::Mat& d, const char* what) {
+  if (d.empty()) return;
+  if (d.type() != CV_8UC1 || d.cols != 32)
+    throw std::invalid_argument(std::string("MatchBruteForce: ") + what +
+                                " descriptors must be CV_8UC1 with 32 columns");
+}
+
+}  // namespace
+
+RotationHistogram::RotationHistogram(int num_bins) {
+  if (num_bins < 1) throw std::invalid_argument("RotationHistogram: num_bins must be >= 1");
+  bins_.resize(num_bins);
+}
+
+void RotationHistogram::Add(float angle_from_deg, float angle_to_deg, int match_index) {
+  float rotation = angle_from_deg - angle_to_deg;
+  rotation = std::fmod(rotation, 360.f);
+  if (rotation < 0.f) rotation += 360.f;
+  const int num_bins = NumBins();
+  int bin = static_cast<int>(std::lround(rotation * num_bins / 360.f));
+  if (bin == num_bins) bin = 0;
+  bins_[bin].push_back(match_index);
+}
+
+std::vector<bool> RotationHistogram::DominantBins() const {
+  // The three largest bins; equal counts go to the lower bin index.
+  int best[3] = {-1, -1, -1};
+  auto count = [&](int b) { return b < 0 ? -1 : static_cast<int>(bins_[b].size()); };
+  for (int b = 0; b < NumBins(); ++b) {
+    const int n = static_cast<int>(bins_[b].size());
+    if (n > count(best[0])) {
+      best[2] = best[1];
+      best[1] = best[0];
+      best[0] = b;
+    } else if (n > count(best[1])) {
+      best[2] = best[1];
+      best[1] = b;
+    } else if (n > count(best[2])) {
+      best[2] = b;
+    }
+  }
+  std::vector<bool> dominant(bins_.size(), false);
+  const int top = count(best[0]);
+  if (top <= 0) return dominant;
+  dominant[best[0]] = true;
+  // Weaker peaks count only if they are a real mode (>= 10% of the strongest), as in ORB-SLAM.
+  if (count(best[1]) >= 0.1 * top && count(best[1]) > 0) {
+    dominant[best[1]] = true;
+    if (count(best[2]) >= 0.1 * top && count(best[2]) > 0) dominant[best[2]] = true;
+  }
+  return dominant;
+}
+
+std::vector<int> RotationHistogram::InconsistentMatches() const {
+  const std::vector<bool> dominant = DominantBins();
+  std::vector<int> out;
+  for (int b = 0; b < NumBins(); ++b)
+    if (!dominant[b]) out.insert(out.end(), bins_[b].begin(), bins_[b].end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<int> RotationHistogram::ConsistentMatches() const {
+  const std::vector<bool> dominant = DominantBins();
+  std::vector<int> out;
+  for (int b = 0; b < NumBins(); ++b)
+    if (dominant[b]) out.insert(out.end(), bins_[b].begin(), bins_[b].end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+KeypointGrid::KeypointGrid(const std::vector<cv::KeyPoint>& keypoints, cv::Size image_size,
+                           int cell_size_px)
+    : image_size_(image_size), cell_size_(cell_size_px) {
+  if (image_size.width <= 0 || image_size.height <= 0)
+    throw std::invalid_argument("KeypointGrid: image size must be positive");
+  if (cell_size_px < 1) throw std::invalid_argument("KeypointGrid: cell size must be >= 1");
+  cols_ = (image_size.width + cell_size_ - 1) / cell_size_;
+  rows_ = (image_size.height + cell_size_ - 1) / cell_size_;
+  cells_.resize(static_cast<size_t>(cols_) * rows_);
+  points_.reserve(keypoints.size());
+  octaves_.reserve(keypoints.size());
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    points_.push_back(keypoints[i].pt);
+    octaves_.push_back(keypoints[i].octave);
+    cells_[static_cast<size_t>(CellY(keypoints[i].pt.y)) * cols_ + CellX(keypoints[i].pt.x)]
+        .push_back(i);
+  }
+}
+
+int KeypointGrid::CellX(float u) const {
+  if (!(u >= 0.f)) return 0;  // also NaN
+  return std::min(cols_ - 1, static_cast<int>(u / cell_size_));
+}
+
+int KeypointGrid::CellY(float v) const {
+  if (!(v >= 0.f)) return 0;
+  return std::min(rows_ - 1, static_cast<int>(v / cell_size_));
+}
+
+std::vector<size_t> KeypointGrid::FeaturesInArea(float u, float v, float r, int min_level,
+                                                 int max_level) const {
+  std::vector<size_t> out;
+  if (!(r >= 0.f) || !std::isfinite(u) || !std::isfinite(v)) return out;
+  const int cx0 = CellX(u - r), cx1 = CellX(u + r);
+  const int cy0 = CellY(v - r), cy1 = CellY(v + r);
+  for (int cy = cy0; cy <= cy1; ++cy) {
+    for (int cx = cx0; cx <= cx1; ++cx) {
+      for (size_t i : cells_[static_cast<size_t>(cy) * cols_ + cx]) {
+        if (min_level >= 0 && octaves_[i] < min_level) continue;
+        if (max_level >= 0 && octaves_[i] > max_level) continue;
+        if (std::abs(points_[i].x - u) <= r && std::abs(points_[i].y - v) <= r) out.push_back(i);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<cv::DMatch> MatchBruteForce(const cv::Mat& query, const cv::Mat& train,
+                                        const BruteForceMatchOptions& options) {
+  CheckDescriptors(query, "query");
+  CheckDescriptors(train, "train");
+  std::vector<cv::DMatch> matches;
+  if (query.empty() || train.empty()) return matches;
+  for (int q = 0; q < query.rows; ++q) {
+    const cv::Mat qrow = query.row(q);
+    int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
+    int best_idx = -1;
+    for (int t = 0; t < train.rows; ++t) {
+      const int d = DescriptorDistance(qrow, train.row(t));
+      if (d < best) {
+        second = best;
+        best = d;
+        best_idx = t;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best_idx < 0 || best > options.max_distance) continue;
+    // With a single train row there is no second best: the ratio test passes.
+    if (second != std::numeric_limits<int>::max() &&
+        !(static_cast<double>(best) < options.ratio * second))
+      continue;
+    matches.emplace_back(q, best_idx, static_cast<float>(best));
+  }
+  if (options.unique_train) {
+    // Keep the closest query for each train row (lowest query index on ties).
+    std::vector<int> owner(train.rows, -1);
+    for (size_t i = 0; i < matches.size(); ++i) {
+      int& o = owner[matches[i].trainIdx];
+      if (o < 0 || matches[i].distance < matches[o].distance) o = static_cast<int>(i);
+    }
+    std::vector<cv::DMatch> unique;
+    for (size_t i = 0; i < matches.size(); ++i)
+      if (owner[matches[i].trainIdx] == static_cast<int>(i)) unique.push_back(matches[i]);
+    matches = std::move(unique);
+  }
+  return matches;
+}
+
+}  // namespace ademono
