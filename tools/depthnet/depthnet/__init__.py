@@ -1,0 +1,1 @@
+"""ademono's absolute depth network (ZoeDepth-style, log-binomial metric bins with bin splitting)."""
