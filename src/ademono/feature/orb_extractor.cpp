@@ -1,10 +1,7 @@
 #include "ademono/feature/orb_extractor.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -365,19 +362,6 @@ void OrbExtractor::Extract(const cv::Mat& image, std::vector<cv::KeyPoint>& keyp
     level_descriptors.push_back(desc);
   }
   if (!level_descriptors.empty()) cv::vconcat(level_descriptors, descriptors);
-}
-
-int DescriptorDistance(const cv::Mat& a, const cv::Mat& b) {
-  const uchar* pa = a.ptr<uchar>();
-  const uchar* pb = b.ptr<uchar>();
-  int distance = 0;
-  for (int i = 0; i < 4; ++i) {
-    uint64_t wa, wb;
-    std::memcpy(&wa, pa + 8 * i, 8);  // rows need not be 8-byte aligned
-    std::memcpy(&wb, pb + 8 * i, 8);
-    distance += std::popcount(wa ^ wb);
-  }
-  return distance;
 }
 
 }  // namespace ademono
