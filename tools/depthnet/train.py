@@ -64,6 +64,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--threads", type=int, default=1, choices=[1, 2])
     p.add_argument("--time-budget", type=float, default=0.0, help="minutes of training (0 = none)")
+    p.add_argument("--stop-after", type=int, default=0,
+                   help="stop after this many epochs in total (schedule still uses --epochs)")
     p.add_argument("--resume", action="store_true", help="continue from OUT/last.pt")
     p.add_argument("--log-every", type=int, default=10, help="steps between progress lines")
     return p
@@ -221,6 +223,9 @@ def main(argv=None) -> int:
         if val:
             msg += f", val AbsRel {val['abs_rel']:.4f} RMSE {val['rmse']:.4f} delta1 {val['delta1']:.4f}"
         print(msg + f", {elapsed / 60:.1f} min, saved {last_path}", flush=True)
+        if args.stop_after and epoch + 1 >= args.stop_after and not stopped:
+            print(f"stopping after epoch {epoch + 1} (--stop-after); --resume continues")
+            break
         if stopped:
             print(f"time budget of {args.time_budget} min reached during epoch {epoch + 1}; "
                   f"--resume continues from the start of that epoch")
