@@ -2,6 +2,7 @@
 
 #include "ademono/core/error.h"
 #include "ademono/depth/cache_depth.h"
+#include "ademono/depth/onnx_depth.h"
 #include "ademono/depth/sensor_depth.h"
 
 namespace ademono {
@@ -30,7 +31,7 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
   // --- simulated[:k=v,...] (engineer "synth" adds this branch) ---
   if (kind == "simulated") ThrowNotAvailable(kind);
   // --- model:FILE.onnx[,spec=Y.yaml] (engineer "onnx" adds this branch) ---
-  if (kind == "model") ThrowNotAvailable(kind);
+  if (kind == "model") return MakeOnnxDepthProvider(argument, context);
 
   throw InputError("unknown depth provider '" + spec +
                    "' (expected sensor, cache:DIR, simulated[:k=v,...] or model:FILE.onnx)");

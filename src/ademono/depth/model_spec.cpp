@@ -1,0 +1,241 @@
+#include "ademono/depth/model_spec.h"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <stdexcept>
+
+#include "ademono/core/error.h"
+
+namespace ademono {
+namespace {
+
+void RequireKnownKeys(const YAML::Node& node, const std::set<std::string>& keys,
+                      const std::string& where, const std::filesystem::path& path) {
+  if (!node) return;
+  if (!node.IsMap()) ThrowInputError(path, "'" + where + "' must be a mapping");
+  for (const auto& item : node) {
+    const std::string key = item.first.as<std::string>();
+    if (!keys.count(key)) ThrowInputError(path, "unknown key '" + where + "." + key + "'");
+  }
+}
+
+template <typename T>
+void Read(const YAML::Node& node, const char* key, const std::string& where,
+          const std::filesystem::path& path, T* value) {
+  if (!node || !node[key]) return;
+  try {
+    *value = node[key].as<T>();
+  } catch (const YAML::Exception&) {
+    ThrowInputError(path, "'" + where + "." + key + "' has a bad value");
+  }
+}
+
+std::array<double, 3> ReadTriple(const YAML::Node& node, const char* key, const std::string& where,
+                                 const std::filesystem::path& path, std::array<double, 3> value) {
+  if (!node || !node[key]) return value;
+  const YAML::Node list = node[key];
+  try {
+    if (list.IsScalar()) {
+      value.fill(list.as<double>());
+    } else if (list.IsSequence() && list.size() == 3) {
+      for (int i = 0; i < 3; ++i) value[i] = list[i].as<double>();
+    } else {
+      ThrowInputError(path, "'" + where + "." + key + "' must be a number or a list of 3 numbers");
+    }
+  } catch (const YAML::Exception&) {
+    ThrowInputError(path, "'" + where + "." + key + "' must be a number or a list of 3 numbers");
+  }
+  return value;
+}
+
+template <typename E>
+E ReadChoice(const YAML::Node& node, const char* key, const std::string& where,
+             const std::filesystem::path& path,
+             const std::vector<std::pair<std::string, E>>& choices, E value) {
+  std::string text;
+  Read(node, key, where, path, &text);
+  if (text.empty()) return value;
+  std::string expected;
+  for (const auto& [name, choice] : choices) {
+    if (name == text) return choice;
+    expected += (expected.empty() ? "" : ", ") + name;
+  }
+  ThrowInputError(path,
+                  "'" + where + "." + key + "' is '" + text + "', expected one of " + expected);
+}
+
+int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
+
+}  // namespace
+
+std::string ToString(DepthModelSpec::Kind kind) {
+  switch (kind) {
+    case DepthModelSpec::Kind::kMetric:
+      return "metric";
+    case DepthModelSpec::Kind::kInverse:
+      return "inverse";
+    case DepthModelSpec::Kind::kDisparity:
+      return "disparity";
+  }
+  return "?";
+}
+
+std::string ToString(DepthModelSpec::Resize resize) {
+  switch (resize) {
+    case DepthModelSpec::Resize::kFixed:
+      return "fixed";
+    case DepthModelSpec::Resize::kLetterbox:
+      return "letterbox";
+    case DepthModelSpec::Resize::kMultiple:
+      return "multiple";
+  }
+  return "?";
+}
+
+void DepthModelSpec::Check() const {
+  auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  if (resize != Resize::kMultiple) {
+    if (width < 0 || height < 0 || (width == 0) != (height == 0)) {
+      fail("input.width and input.height must both be positive (or both 0 = model size)");
+    }
+  } else {
+    if (side_length < 0) fail("input.side_length must be >= 0");
+  }
+  if (multiple_of < 1) fail("input.multiple_of must be >= 1");
+  for (int c = 0; c < 3; ++c) {
+    if (!(std[c] > 0)) fail("input.std must be positive");
+  }
+  if (kind == Kind::kDisparity && !(baseline_focal > 0)) {
+    fail("output.baseline_focal must be positive for kind disparity");
+  }
+  if (kind != Kind::kDisparity && !(scale > 0)) fail("output.scale must be positive");
+  if (canonical_focal < 0) fail("output.canonical_focal must be >= 0");
+  if (canonical_focal > 0 && kind != Kind::kMetric) {
+    fail("output.canonical_focal applies to kind metric only");
+  }
+  if (!(min_depth >= 0 && max_depth > min_depth)) {
+    fail("output.min_depth/max_depth must satisfy 0 <= min_depth < max_depth");
+  }
+}
+
+DepthModelSpec DepthModelSpec::FromYaml(const YAML::Node& node, const std::filesystem::path& path) {
+  DepthModelSpec spec;
+  if (!node || !node.IsMap()) ThrowInputError(path, "model spec must be a YAML mapping");
+  RequireKnownKeys(node, {"name", "input", "output"}, "spec", path);
+  Read(node, "name", "spec", path, &spec.name);
+  const YAML::Node in = node["input"];
+  RequireKnownKeys(in,
+                   {"resize", "width", "height", "side", "side_length", "multiple_of", "pad",
+                    "pad_value", "interpolation", "color", "units", "mean", "std"},
+                   "input", path);
+  spec.resize = ReadChoice<Resize>(in, "resize", "input", path,
+                                   {{"fixed", Resize::kFixed},
+                                    {"letterbox", Resize::kLetterbox},
+                                    {"multiple", Resize::kMultiple}},
+                                   spec.resize);
+  Read(in, "width", "input", path, &spec.width);
+  Read(in, "height", "input", path, &spec.height);
+  spec.long_side =
+      ReadChoice<bool>(in, "side", "input", path, {{"long", true}, {"short", false}}, true);
+  Read(in, "side_length", "input", path, &spec.side_length);
+  Read(in, "multiple_of", "input", path, &spec.multiple_of);
+  spec.pad = ReadChoice<PadPlacement>(in, "pad", "input", path,
+                                      {{"centre", PadPlacement::kCentre},
+                                       {"center", PadPlacement::kCentre},
+                                       {"bottom_right", PadPlacement::kTopLeft}},
+                                      spec.pad);
+  spec.pad_value = ReadTriple(in, "pad_value", "input", path, spec.pad_value);
+  spec.interpolation = ReadChoice<int>(in, "interpolation", "input", path,
+                                       {{"linear", cv::INTER_LINEAR},
+                                        {"cubic", cv::INTER_CUBIC},
+                                        {"area", cv::INTER_AREA},
+                                        {"nearest", cv::INTER_NEAREST}},
+                                       spec.interpolation);
+  spec.rgb = ReadChoice<bool>(in, "color", "input", path, {{"rgb", true}, {"bgr", false}}, true);
+  const bool unit = ReadChoice<bool>(in, "units", "input", path, {{"unit", true}, {"byte", false}},
+                                     /*default: mean/std in 0..1*/ true);
+  const double factor = unit ? 255.0 : 1.0;
+  std::array<double, 3> mean{0.485, 0.456, 0.406}, std{0.229, 0.224, 0.225};
+  if (!unit) {
+    for (int c = 0; c < 3; ++c) mean[c] *= 255, std[c] *= 255;
+  }
+  mean = ReadTriple(in, "mean", "input", path, mean);
+  std = ReadTriple(in, "std", "input", path, std);
+  for (int c = 0; c < 3; ++c) {
+    spec.mean[c] = mean[c] * factor;
+    spec.std[c] = std[c] * factor;
+  }
+
+  const YAML::Node out = node["output"];
+  RequireKnownKeys(out,
+                   {"kind", "scale", "baseline_focal", "canonical_focal", "min_depth", "max_depth"},
+                   "output", path);
+  spec.kind = ReadChoice<Kind>(
+      out, "kind", "output", path,
+      {{"metric", Kind::kMetric}, {"inverse", Kind::kInverse}, {"disparity", Kind::kDisparity}},
+      spec.kind);
+  Read(out, "scale", "output", path, &spec.scale);
+  Read(out, "baseline_focal", "output", path, &spec.baseline_focal);
+  Read(out, "canonical_focal", "output", path, &spec.canonical_focal);
+  Read(out, "min_depth", "output", path, &spec.min_depth);
+  Read(out, "max_depth", "output", path, &spec.max_depth);
+  try {
+    spec.Check();
+  } catch (const std::invalid_argument& e) {
+    ThrowInputError(path, e.what());
+  }
+  return spec;
+}
+
+DepthModelSpec DepthModelSpec::Load(const std::filesystem::path& path) {
+  RequireFile(path);
+  YAML::Node node;
+  try {
+    node = YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(path, "not valid YAML: " + e.msg);
+  }
+  return FromYaml(node, path);
+}
+
+void DepthModelSpec::InputGeometry(cv::Size image_size, cv::Size* input_size,
+                                   cv::Size* content_size) const {
+  switch (resize) {
+    case Resize::kFixed:
+      *input_size = {width, height};
+      *content_size = *input_size;
+      return;
+    case Resize::kLetterbox:
+      *input_size = {width, height};
+      *content_size = FitInside(image_size, *input_size, /*round_content=*/true);
+      return;
+    case Resize::kMultiple: {
+      double s = 1.0;
+      if (side_length > 0) {
+        const int side = long_side ? std::max(image_size.width, image_size.height)
+                                   : std::min(image_size.width, image_size.height);
+        s = static_cast<double>(side_length) / side;
+      }
+      *content_size = {std::max(1, static_cast<int>(std::lround(image_size.width * s))),
+                       std::max(1, static_cast<int>(std::lround(image_size.height * s)))};
+      *input_size = {RoundUp(content_size->width, multiple_of),
+                     RoundUp(content_size->height, multiple_of)};
+      return;
+    }
+  }
+}
+
+double DepthModelSpec::ToDepth(double y, double focal_scale) const {
+  switch (kind) {
+    case Kind::kMetric:
+      return scale * y * focal_scale;
+    case Kind::kInverse:
+      return y > 0 ? scale / y : 0.0;
+    case Kind::kDisparity:
+      return y > 0 ? baseline_focal / y : 0.0;
+  }
+  return 0.0;
+}
+
+}  // namespace ademono

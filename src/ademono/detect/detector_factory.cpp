@@ -1,0 +1,121 @@
+#include "ademono/detect/detector_factory.h"
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "ademono/core/error.h"
+#include "ademono/detect/detection_io.h"
+#include "ademono/detect/yolo_detector.h"
+#include "ademono/dnn/model_arg.h"
+
+namespace ademono {
+namespace {
+
+class NoDetector : public Detector {
+ public:
+  std::string Name() const override { return "none"; }
+  std::vector<Detection> Detect(const FrameData&) override { return {}; }
+};
+
+// Detections read back from a JSON-lines cache, matched by frame name, else timestamp (1 ms),
+// else index; only classes in `class_ids` (empty = all) are returned.
+class CacheDetector : public Detector {
+ public:
+  CacheDetector(const std::filesystem::path& path, std::vector<int> class_ids)
+      : path_(path), frames_(ReadDetectionsJsonl(path)), class_ids_(std::move(class_ids)) {
+    for (size_t i = 0; i < frames_.size(); ++i) {
+      if (!frames_[i].name.empty()) by_name_.emplace(frames_[i].name, i);
+      by_time_.emplace(frames_[i].timestamp, i);
+      by_index_.emplace(frames_[i].frame, i);
+    }
+  }
+  std::string Name() const override { return "cache:" + path_.string(); }
+  std::vector<Detection> Detect(const FrameData& frame) override {
+    const FrameDetections& entry = frames_[Find(frame)];
+    std::vector<Detection> detections;
+    for (const auto& d : entry.detections) {
+      if (class_ids_.empty() ||
+          std::find(class_ids_.begin(), class_ids_.end(), d.class_id) != class_ids_.end()) {
+        detections.push_back(d);
+      }
+    }
+    return detections;
+  }
+
+ private:
+  size_t Find(const FrameData& frame) const {
+    if (!frame.name.empty()) {
+      if (auto it = by_name_.find(frame.name); it != by_name_.end()) return it->second;
+    }
+    constexpr double kTolerance = 1e-3;
+    auto it = by_time_.lower_bound(frame.timestamp - kTolerance);
+    if (it != by_time_.end() && std::abs(it->first - frame.timestamp) <= kTolerance) {
+      return it->second;
+    }
+    if (auto at = by_index_.find(frame.index); at != by_index_.end()) return at->second;
+    ThrowInputError(path_, "no detections for frame " + std::to_string(frame.index) + " ('" +
+                               frame.name + "', t=" + std::to_string(frame.timestamp) + ")");
+  }
+
+  std::filesystem::path path_;
+  std::vector<FrameDetections> frames_;
+  std::vector<int> class_ids_;
+  std::map<std::string, size_t> by_name_;
+  std::multimap<double, size_t> by_time_;
+  std::map<size_t, size_t> by_index_;
+};
+
+}  // namespace
+
+void DetectorOptions::Check() const {
+  if (!(score_threshold >= 0.f && score_threshold <= 1.f)) {
+    throw std::invalid_argument("detector score threshold must be in [0, 1], got " +
+                                std::to_string(score_threshold));
+  }
+  if (!(nms_iou > 0.f && nms_iou <= 1.f)) {
+    throw std::invalid_argument("detector NMS IoU must be in (0, 1], got " +
+                                std::to_string(nms_iou));
+  }
+  for (int id : class_ids) {
+    if (id < 0)
+      throw std::invalid_argument("detector class ids must be >= 0, got " + std::to_string(id));
+  }
+  if (num_threads < 1 || num_threads > 64) {
+    throw std::invalid_argument("detector threads must be in [1, 64], got " +
+                                std::to_string(num_threads));
+  }
+}
+
+std::unique_ptr<Detector> MakeDetector(const std::string& spec, const DetectorOptions& options) {
+  try {
+    options.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
+  const size_t colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string argument = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (kind == "none" && colon == std::string::npos) return std::make_unique<NoDetector>();
+  if (kind == "cache") {
+    if (argument.empty()) throw InputError("detector 'cache' needs a file: cache:FILE.jsonl");
+    return std::make_unique<CacheDetector>(argument, options.class_ids);
+  }
+  if (kind == "model") {
+    const ModelArg model = ParseModelArg(argument, {"arch"});
+    YoloArch arch = YoloArch::kAuto;
+    if (auto it = model.options.find("arch"); it != model.options.end()) {
+      try {
+        arch = ParseYoloArch(it->second);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(e.what());
+      }
+    }
+    return std::make_unique<YoloDetector>(model.file, arch, options);
+  }
+  throw InputError(
+      "unknown detector '" + spec +
+      "' (expected none, cache:FILE.jsonl or model:FILE.onnx[,arch=yolox|yolov5|yolov8])");
+}
+
+}  // namespace ademono

@@ -1,0 +1,64 @@
+// The real YOLOX-nano model on real photos must reproduce the reference decoder's detections
+// (../shared/images/expected_detections.json, made with OpenCV DNN).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "ademono/core/file_util.h"
+#include "ademono/detect/yolo_detector.h"
+
+namespace ademono {
+namespace {
+
+const std::filesystem::path kShared = ADEMONO_SHARED_DIR;
+
+float IouOf(const cv::Rect2f& a, const cv::Rect2f& b) {
+  const float inter = (a & b).area();
+  return inter / (a.area() + b.area() - inter);
+}
+
+TEST(YoloxReferenceTest, ReproducesExpectedDetections) {
+  const auto model = kShared / "models/yolox_nano.onnx";
+  if (!std::filesystem::exists(model)) GTEST_SKIP() << "no " << model;
+  std::ifstream in(kShared / "images/expected_detections.json");
+  const auto expected = nlohmann::json::parse(in);
+  DetectorOptions options;
+  options.score_threshold = expected["score_threshold"].get<float>();
+  options.nms_iou = expected["nms_iou"].get<float>();
+  options.class_ids.clear();  // all 80 classes
+  YoloDetector detector(model, YoloArch::kAuto, options);
+  EXPECT_EQ(detector.Arch(), YoloArch::kYolox);
+  EXPECT_EQ(detector.InputSize(), cv::Size(416, 416));
+  for (const auto& [file, image_json] : expected["images"].items()) {
+    SCOPED_TRACE(file);
+    const cv::Mat image = ReadImage(kShared / "images" / file, cv::IMREAD_COLOR);
+    ASSERT_EQ(image.cols, image_json["width"].get<int>());
+    const auto detections = detector.DetectImage(image);
+    const auto& want = image_json["detections"];
+    EXPECT_EQ(detections.size(), want.size());
+    for (const auto& d : detections)
+      std::cerr << file << " " << d.class_name << " " << d.score << " " << d.box << "\n";
+    std::vector<bool> used(detections.size(), false);
+    for (const auto& w : want) {
+      const auto box = w["box_xywh"].get<std::vector<float>>();
+      const cv::Rect2f want_box(box[0], box[1], box[2], box[3]);
+      int best = -1;
+      float best_iou = 0.f;
+      for (size_t i = 0; i < detections.size(); ++i) {
+        if (used[i] || detections[i].class_id != w["class_id"].get<int>()) continue;
+        const float iou = IouOf(detections[i].box, want_box);
+        if (iou > best_iou) best_iou = iou, best = static_cast<int>(i);
+      }
+      ASSERT_GE(best, 0) << "no " << w["class"] << " detection for " << w.dump();
+      used[best] = true;
+      EXPECT_GE(best_iou, 0.9f) << w.dump();
+      EXPECT_NEAR(detections[best].score, w["score"].get<float>(), 0.02f) << w.dump();
+      EXPECT_EQ(detections[best].class_name, w["class"].get<std::string>());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ademono
