@@ -3,7 +3,8 @@
 
 ONNX contract (what configs/models/ademono_depthnet.yaml describes):
   input  "image": 1 x 3 x H x W float32, RGB, pixel / 255 (0..1); H x W fixed (the model's input
-                  size, 144 x 192 for the small variant); the whole frame resized to it.
+                  size, 144 x 192 for the small variant); the whole frame resized to it
+                  (cv2.INTER_AREA, as in training).
   output "depth": 1 x 1 x H x W float32, metric depth in metres.
 The ImageNet normalisation is inside the graph. Opset 13 by default.
 
@@ -42,27 +43,33 @@ def export(model: DepthNet, path: str, opset: int = 13) -> None:
     os.replace(tmp, path)
 
 
-def spec_yaml(model: DepthNet) -> str:
+def spec_yaml(model: DepthNet, name: str = "ademono_depthnet") -> str:
     cfg = model.config
-    return SPEC_TEMPLATE.format(width=cfg.input_width, height=cfg.input_height,
+    return SPEC_TEMPLATE.format(name=name, width=cfg.input_width, height=cfg.input_height,
                                 min_depth=cfg.min_depth, max_depth=cfg.max_depth)
 
 
 SPEC_TEMPLATE = """\
-# ademono depth network (tools/depthnet), exported by tools/depthnet/export_onnx.py.
-# Model spec for `--depth model:FILE.onnx,spec=configs/models/ademono_depthnet.yaml`.
-input_name: image
-output_name: depth
-input_width: {width}
-input_height: {height}
-resize: stretch          # whole frame resized to the input (no letterbox)
-color_order: rgb
-mean: [0.0, 0.0, 0.0]    # 0..255 units: input = pixel / 255; ImageNet normalisation is in the graph
-std: [255.0, 255.0, 255.0]
-output: metric_depth     # metres, 1 x 1 x H x W at the input resolution
-output_scale: 1.0
-min_depth: {min_depth}
-max_depth: {max_depth}
+# ademono's own depth network (tools/depthnet, docs/depthnet.md), exported by
+# tools/depthnet/export_onnx.py. Format: src/ademono/depth/model_spec.h.
+#   ademono ... --depth model:FILE.onnx,spec=configs/models/ademono_depthnet.yaml
+# ONNX: input "image" 1x3xHxW RGB in 0..1 (ImageNet normalisation is inside the graph),
+# output "depth" 1x1xHxW metric depth in metres at the input resolution.
+name: {name}
+input:
+  resize: fixed          # whole frame stretched to the training input (4:3 frames keep aspect)
+  width: {width}
+  height: {height}
+  interpolation: area    # as in training (cv2.INTER_AREA when shrinking)
+  color: rgb
+  units: unit            # x = (p / 255 - mean) / std
+  mean: [0.0, 0.0, 0.0]
+  std: [1.0, 1.0, 1.0]
+output:
+  kind: metric
+  scale: 1.0
+  min_depth: 0.0         # the metric bins span [{min_depth}, {max_depth}] m
+  max_depth: {max_depth}
 """
 
 

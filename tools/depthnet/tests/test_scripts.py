@@ -10,6 +10,7 @@ import numpy as np
 import onnx
 import pytest
 import torch
+import yaml
 
 import evaluate
 import export_onnx
@@ -73,7 +74,17 @@ def test_train_resume_evaluate_export(tmp_path, capsys):
     assert [i.name for i in proto.graph.input] == ["image"]
     dims = [d.dim_value for d in proto.graph.output[0].type.tensor_type.shape.dim]
     assert dims == [1, 1, 32, 48]
-    assert "input_width: 48" in open(spec_path).read()
+    spec = yaml.safe_load(open(spec_path))
+    assert (spec["input"]["width"], spec["input"]["height"]) == (48, 32)
+    assert spec["output"]["kind"] == "metric" and spec["input"]["color"] == "rgb"
+
+
+def test_committed_spec_matches_small_variant(tool_dir):
+    """configs/models/ademono_depthnet.yaml is what export_onnx writes for the small variant."""
+    from depthnet.model import SMALL, DepthNet
+
+    committed = os.path.join(tool_dir, "..", "..", "configs", "models", "ademono_depthnet.yaml")
+    assert open(committed).read() == export_onnx.spec_yaml(DepthNet(SMALL), "ademono_depthnet_small")
 
 
 def test_train_rejects_bad_input(tmp_path, capsys):
