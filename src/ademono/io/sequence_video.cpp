@@ -1,0 +1,105 @@
+// A video file read with cv::VideoCapture. The frame count and timestamps (index / fps) are
+// established once at open by grabbing through the file, because container frame counts are
+// often wrong. Decoding is sequential: the capture is kept at the next frame so in-order Load()
+// costs one decode; going backwards reopens the file. A mutex serialises access to the capture.
+#include <mutex>
+#include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
+
+#include "ademono/core/error.h"
+#include "ademono/core/file_util.h"
+#include "ademono/io/file_sequence.h"
+
+namespace fs = std::filesystem;
+
+namespace ademono {
+
+namespace {
+
+class VideoSequence : public Sequence {
+ public:
+  VideoSequence(fs::path file, Camera camera) : file_(std::move(file)), camera_(camera) {
+    Reopen();
+    double fps = capture_.get(cv::CAP_PROP_FPS);
+    if (!(fps > 0 && fps < 1000)) fps = 30.0;
+    size_t count = 0;
+    while (capture_.grab()) ++count;
+    if (count == 0) ThrowInputError(file_, "sequence has no frames");
+    for (size_t i = 0; i < count; ++i) timestamps_.push_back(static_cast<double>(i) / fps);
+    Reopen();
+  }
+
+  std::string Kind() const override { return "video"; }
+  fs::path Path() const override { return file_; }
+  size_t Size() const override { return timestamps_.size(); }
+  const Camera& GetCamera() const override { return camera_; }
+  bool HasDepth() const override { return false; }
+  bool HasGroundTruth() const override { return false; }
+  double Timestamp(size_t i) const override { return timestamps_.at(i); }
+
+  FrameData Load(size_t i) const override {
+    if (i >= Size()) throw std::out_of_range("video frame index out of range");
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!(cached_index_ && *cached_index_ == i)) {
+      if (i < next_index_) Reopen();
+      while (next_index_ < i) {
+        if (!capture_.grab()) ThrowDecodeError(next_index_);
+        ++next_index_;
+      }
+      cv::Mat image;
+      if (!capture_.read(image) || image.empty()) ThrowDecodeError(i);
+      ++next_index_;
+      cached_ = ToBgr8(image, file_);
+      cached_index_ = i;
+      if (cached_.cols != camera_.width || cached_.rows != camera_.height) {
+        ThrowInputError(file_, "frames are " + std::to_string(cached_.cols) + "x" +
+                                   std::to_string(cached_.rows) + ", the camera is " +
+                                   std::to_string(camera_.width) + "x" +
+                                   std::to_string(camera_.height));
+      }
+    }
+    FrameData frame;
+    frame.index = i;
+    frame.timestamp = timestamps_[i];
+    frame.name = "frame-" + std::to_string(i);
+    frame.image = cached_.clone();
+    return frame;
+  }
+
+ private:
+  void Reopen() const {
+    capture_.release();
+    // FFmpeg when the build has it: deterministic frame order and no GStreamer console noise.
+    const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
+    if (!capture_.open(file_.string(), api)) ThrowInputError(file_, "cannot open as a video");
+    next_index_ = 0;
+    cached_index_.reset();
+  }
+  [[noreturn]] void ThrowDecodeError(size_t i) const {
+    ThrowInputError(file_, "frame " + std::to_string(i) + " does not decode");
+  }
+
+  fs::path file_;
+  Camera camera_;
+  std::vector<double> timestamps_;
+  mutable std::mutex mutex_;
+  mutable cv::VideoCapture capture_;
+  mutable size_t next_index_ = 0;
+  mutable std::optional<size_t> cached_index_;
+  mutable cv::Mat cached_;
+};
+
+}  // namespace
+
+std::unique_ptr<Sequence> OpenVideo(const fs::path& file,
+                                    const std::optional<fs::path>& camera_yaml) {
+  RequireFile(file);
+  std::optional<Camera> beside;
+  const fs::path beside_yaml = file.parent_path() / "camera.yaml";
+  if (fs::exists(beside_yaml)) beside = LoadCameraYaml(beside_yaml);
+  const Camera camera = ResolveCamera(
+      camera_yaml, beside, file, "a video needs a camera YAML (--camera or camera.yaml beside it)");
+  return std::make_unique<VideoSequence>(file, camera);
+}
+
+}  // namespace ademono
