@@ -1,0 +1,161 @@
+#include "ademono/slam/frame.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ademono/slam/map_point.h"
+
+namespace ademono {
+
+ScalePyramid ScalePyramid::Make(int num_levels, float scale_factor) {
+  ScalePyramid p;
+  p.num_levels = num_levels;
+  p.log_scale_factor = std::log(scale_factor);
+  p.scale_factors.resize(num_levels);
+  p.inv_scale_factors.resize(num_levels);
+  p.level_sigma2.resize(num_levels);
+  p.inv_level_sigma2.resize(num_levels);
+  float s = 1.f;
+  for (int i = 0; i < num_levels; ++i) {
+    p.scale_factors[i] = s;
+    p.inv_scale_factors[i] = 1.f / s;
+    p.level_sigma2[i] = s * s;
+    p.inv_level_sigma2[i] = 1.f / (s * s);
+    s *= scale_factor;
+  }
+  return p;
+}
+
+std::shared_ptr<const FrameFeatures> MakeFrameFeatures(
+    const Camera& camera, std::shared_ptr<const ScalePyramid> pyramid, double virtual_baseline,
+    double close_depth, std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
+    std::vector<float> depth) {
+  auto f = std::make_shared<FrameFeatures>();
+  f->camera = camera;
+  f->pyramid = std::move(pyramid);
+  f->intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy, virtual_baseline * camera.fx};
+  f->close_depth = static_cast<float>(close_depth);
+  f->keypoints = std::move(keypoints);
+  f->descriptors = std::move(descriptors);
+  f->depth = std::move(depth);
+  const size_t n = f->keypoints.size();
+  f->depth.resize(n, -1.f);
+
+  // Undistorted keypoints and image bounds.
+  f->keypoints_un = f->keypoints;
+  if (camera.HasDistortion() && n > 0) {
+    std::vector<cv::Point2f> pts(n);
+    for (size_t i = 0; i < n; ++i) pts[i] = f->keypoints[i].pt;
+    const std::vector<cv::Point2f> un = camera.Undistort(pts);
+    for (size_t i = 0; i < n; ++i) f->keypoints_un[i].pt = un[i];
+  }
+  if (camera.HasDistortion()) {
+    const std::vector<cv::Point2f> corners{{0.f, 0.f},
+                                           {static_cast<float>(camera.width), 0.f},
+                                           {0.f, static_cast<float>(camera.height)},
+                                           {static_cast<float>(camera.width), static_cast<float>(camera.height)}};
+    const std::vector<cv::Point2f> un = camera.Undistort(corners);
+    f->min_x = std::min(un[0].x, un[2].x);
+    f->max_x = std::max(un[1].x, un[3].x);
+    f->min_y = std::min(un[0].y, un[1].y);
+    f->max_y = std::max(un[2].y, un[3].y);
+  } else {
+    f->max_x = static_cast<float>(camera.width);
+    f->max_y = static_cast<float>(camera.height);
+  }
+
+  f->u_right.assign(n, -1.f);
+  const double bf = f->intrinsics.bf;
+  for (size_t i = 0; i < n; ++i) {
+    if (f->depth[i] > 0) {
+      f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+    } else {
+      f->depth[i] = -1.f;
+    }
+  }
+
+  f->grid.assign(FrameFeatures::kGridCols * FrameFeatures::kGridRows, {});
+  const float cell_w = (f->max_x - f->min_x) / FrameFeatures::kGridCols;
+  const float cell_h = (f->max_y - f->min_y) / FrameFeatures::kGridRows;
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point2f& p = f->keypoints_un[i].pt;
+    const int cx = static_cast<int>(std::floor((p.x - f->min_x) / cell_w));
+    const int cy = static_cast<int>(std::floor((p.y - f->min_y) / cell_h));
+    if (cx < 0 || cx >= FrameFeatures::kGridCols || cy < 0 || cy >= FrameFeatures::kGridRows) continue;
+    f->grid[cy * FrameFeatures::kGridCols + cx].push_back(i);
+  }
+  return f;
+}
+
+std::vector<size_t> FrameFeatures::FeaturesInArea(float u, float v, float r, int min_level,
+                                                  int max_level) const {
+  std::vector<size_t> result;
+  const float cell_w = (max_x - min_x) / kGridCols;
+  const float cell_h = (max_y - min_y) / kGridRows;
+  const int x0 = std::max(0, static_cast<int>(std::floor((u - min_x - r) / cell_w)));
+  const int x1 = std::min(kGridCols - 1, static_cast<int>(std::ceil((u - min_x + r) / cell_w)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((v - min_y - r) / cell_h)));
+  const int y1 = std::min(kGridRows - 1, static_cast<int>(std::ceil((v - min_y + r) / cell_h)));
+  if (x0 > x1 || y0 > y1) return result;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      for (size_t i : grid[y * kGridCols + x]) {
+        const cv::KeyPoint& kp = keypoints_un[i];
+        if (min_level >= 0 && kp.octave < min_level) continue;
+        if (max_level >= 0 && kp.octave > max_level) continue;
+        if (std::abs(kp.pt.x - u) < r && std::abs(kp.pt.y - v) < r) result.push_back(i);
+      }
+    }
+  }
+  std::sort(result.begin(), result.end());
+  return result;
+}
+
+ImageObservation FrameFeatures::Observation(size_t i) const {
+  ImageObservation o;
+  o.pixel = Eigen::Vector2d(keypoints_un[i].pt.x, keypoints_un[i].pt.y);
+  o.u_right = u_right[i];
+  o.inv_sigma2 = pyramid->inv_level_sigma2[keypoints_un[i].octave];
+  return o;
+}
+
+Eigen::Vector3d FrameFeatures::UnprojectCamera(size_t i) const {
+  return camera.Unproject(Eigen::Vector2d(keypoints_un[i].pt.x, keypoints_un[i].pt.y), depth[i]);
+}
+
+Frame::Frame(uint64_t id, size_t index, double timestamp, std::shared_ptr<const FrameFeatures> features)
+    : id(id), index(index), timestamp(timestamp), features(std::move(features)) {
+  map_points.resize(this->features->Size());
+  outlier.assign(this->features->Size(), false);
+}
+
+bool Frame::InFrustum(const MapPoint& point, float view_cos_limit, ProjectionPrediction* prediction) const {
+  const Eigen::Vector3d pc = *cam_from_world * point.position;
+  if (pc.z() <= 0) return false;
+  const FrameFeatures& f = *features;
+  const double inv_z = 1.0 / pc.z();
+  const float u = static_cast<float>(f.intrinsics.fx * pc.x() * inv_z + f.intrinsics.cx);
+  const float v = static_cast<float>(f.intrinsics.fy * pc.y() * inv_z + f.intrinsics.cy);
+  if (!f.InBounds(u, v)) return false;
+  const Eigen::Vector3d po = point.position - CameraCenter();
+  const float dist = static_cast<float>(po.norm());
+  if (dist < 0.8f * point.min_distance || dist > 1.2f * point.max_distance) return false;
+  const float view_cos = static_cast<float>(po.dot(point.normal) / dist);
+  if (view_cos < view_cos_limit) return false;
+  prediction->u = u;
+  prediction->v = v;
+  prediction->u_right = static_cast<float>(u - f.intrinsics.bf * inv_z);
+  prediction->level = point.PredictScale(dist, f.pyramid->log_scale_factor, f.pyramid->num_levels);
+  prediction->view_cos = view_cos;
+  return true;
+}
+
+int Frame::NumTrackedInliers() const {
+  int n = 0;
+  for (size_t i = 0; i < map_points.size(); ++i) {
+    if (map_points[i] && !outlier[i]) ++n;
+  }
+  return n;
+}
+
+}  // namespace ademono

@@ -1,0 +1,57 @@
+#pragma once
+// A keyframe (ORB-SLAM's KeyFrame): the frame's features, its pose, its map points and the
+// covisibility graph with a spanning tree. Guarded by the owning Map's mutex.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "ademono/slam/frame.h"
+#include "ademono/slam/map_point.h"
+
+namespace ademono {
+
+class KeyFrame {
+ public:
+  KeyFrame(uint64_t id, const Frame& frame);
+
+  const uint64_t id;
+  const uint64_t frame_id;
+  const size_t index;
+  const double timestamp;
+  std::shared_ptr<const FrameFeatures> features;
+  Rigid3d cam_from_world;
+  std::vector<std::shared_ptr<MapPoint>> map_points;
+
+  // Covisibility: shared map point counts with other keyframes.
+  std::map<KeyFrame*, int, KeyFrameIdLess> connections;
+  std::vector<KeyFrame*> ordered_connections;  // by weight, descending (ties by id)
+  KeyFrame* parent = nullptr;
+  std::set<KeyFrame*, KeyFrameIdLess> children;
+  Rigid3d cam_from_parent = Rigid3d::Identity();  // set when the keyframe is culled
+  bool bad = false;
+
+  // Scratch of the tracker and local mapping.
+  uint64_t local_map_frame = UINT64_MAX;
+  uint64_t ba_local_for = UINT64_MAX;
+  uint64_t ba_fixed_for = UINT64_MAX;
+  uint64_t fuse_target_for = UINT64_MAX;
+
+  const FrameFeatures& F() const { return *features; }
+  Eigen::Vector3d CameraCenter() const { return cam_from_world.inverse().translation(); }
+  void AddMapPoint(const std::shared_ptr<MapPoint>& point, size_t index) { map_points[index] = point; }
+  void EraseMapPoint(size_t index) { map_points[index].reset(); }
+  void EraseMapPoint(const MapPoint* point);
+  // Map points observed by at least `min_observations` keyframes.
+  int TrackedMapPoints(int min_observations) const;
+  // Recomputes the covisibility edges from the map points (ORB-SLAM's UpdateConnections).
+  void UpdateConnections();
+  std::vector<KeyFrame*> BestCovisibles(size_t n) const;
+  void AddConnection(KeyFrame* other, int weight);
+  void EraseConnection(KeyFrame* other);
+  void SortConnections();
+};
+
+}  // namespace ademono

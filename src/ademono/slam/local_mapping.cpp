@@ -1,0 +1,289 @@
+#include "ademono/slam/local_mapping.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "ademono/optimize/bundle_adjustment.h"
+#include "ademono/slam/matcher.h"
+
+namespace ademono {
+
+LocalMapping::LocalMapping(Map& map, const MappingOptions& options) : map_(map), options_(options) {
+  options_.Check();
+  if (!options_.deterministic) worker_ = std::thread([this] { Run(); });
+}
+
+LocalMapping::~LocalMapping() { Shutdown(); }
+
+void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe) {
+  if (options_.deterministic) {
+    Process(keyframe);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(keyframe);
+  }
+  queue_cv_.notify_one();
+}
+
+bool LocalMapping::Idle() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return queue_.empty() && !busy_;
+}
+
+size_t LocalMapping::QueueSize() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return queue_.size();
+}
+
+double LocalMapping::LastMilliseconds() const {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  return last_ms_;
+}
+
+void LocalMapping::Shutdown() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stop_ = true;
+  }
+  queue_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LocalMapping::Run() {
+  while (true) {
+    std::shared_ptr<KeyFrame> keyframe;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping and drained
+      keyframe = queue_.front();
+      queue_.pop_front();
+      busy_ = true;
+    }
+    Process(keyframe);
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    busy_ = false;
+  }
+}
+
+void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
+  const auto start = std::chrono::steady_clock::now();
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    ProcessNewKeyFrame(*keyframe);
+    CullMapPoints(*keyframe);
+    FuseNeighbours(*keyframe);
+  }
+  // In threaded mode a waiting keyframe is more urgent than refining this one (as ORB-SLAM).
+  const bool more_waiting = !options_.deterministic && QueueSize() > 0;
+  if (options_.local_ba && !more_waiting) LocalBundleAdjustment(*keyframe);
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    CullKeyFrames(*keyframe);
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  last_ms_ = ms;
+}
+
+void LocalMapping::ProcessNewKeyFrame(KeyFrame& keyframe) {
+  if (keyframe.bad) return;
+  for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
+    const auto& point = keyframe.map_points[i];
+    if (!point) continue;
+    if (point->bad) {
+      keyframe.map_points[i].reset();
+      continue;
+    }
+    if (!point->IsInKeyFrame(&keyframe)) {
+      // A tracked point: this keyframe is a new view of it.
+      point->AddObservation(&keyframe, i);
+      point->UpdateNormalAndDepth();
+      point->ComputeDistinctiveDescriptor();
+    } else if (point->first_keyframe_id == keyframe.id) {
+      recent_points_.push_back(point);  // created from this keyframe's depth
+    }
+  }
+  keyframe.UpdateConnections();
+}
+
+void LocalMapping::CullMapPoints(const KeyFrame& keyframe) {
+  std::vector<std::shared_ptr<MapPoint>> kept;
+  kept.reserve(recent_points_.size());
+  for (const auto& point : recent_points_) {
+    if (point->bad) continue;
+    const uint64_t age = keyframe.id - point->first_keyframe_id;
+    if (point->FoundRatio() < options_.cull_found_ratio) {
+      map_.ErasePoint(point.get());
+    } else if (age >= 2 && point->NumObservations() < options_.cull_min_observations) {
+      map_.ErasePoint(point.get());
+    } else if (age < 3) {
+      kept.push_back(point);
+    }
+  }
+  recent_points_ = std::move(kept);
+}
+
+void LocalMapping::FuseNeighbours(KeyFrame& keyframe) {
+  if (keyframe.bad || options_.fuse_neighbours == 0) return;
+  std::vector<KeyFrame*> targets;
+  for (KeyFrame* kf : keyframe.BestCovisibles(options_.fuse_neighbours)) {
+    if (kf->fuse_target_for == keyframe.id) continue;
+    kf->fuse_target_for = keyframe.id;
+    targets.push_back(kf);
+  }
+  const size_t first_ring = targets.size();
+  for (size_t k = 0; k < first_ring; ++k) {
+    for (KeyFrame* kf2 : targets[k]->BestCovisibles(5)) {
+      if (kf2->bad || kf2->fuse_target_for == keyframe.id || kf2 == &keyframe) continue;
+      kf2->fuse_target_for = keyframe.id;
+      targets.push_back(kf2);
+    }
+  }
+  const Matcher matcher(0.6f, true);
+  // This keyframe's points into the neighbours.
+  for (KeyFrame* kf : targets) {
+    std::vector<std::shared_ptr<MapPoint>> points;
+    for (const auto& p : keyframe.map_points) {
+      if (p && !p->bad) points.push_back(p);
+    }
+    matcher.Fuse(map_, *kf, points, static_cast<float>(options_.fuse_radius));
+  }
+  // The neighbours' points into this keyframe.
+  std::vector<std::shared_ptr<MapPoint>> candidates;
+  for (KeyFrame* kf : targets) {
+    for (const auto& p : kf->map_points) {
+      if (!p || p->bad || p->fuse_target_keyframe == keyframe.id) continue;
+      p->fuse_target_keyframe = keyframe.id;
+      candidates.push_back(p);
+    }
+  }
+  matcher.Fuse(map_, keyframe, candidates, static_cast<float>(options_.fuse_radius));
+  for (const auto& p : keyframe.map_points) {
+    if (p && !p->bad) {
+      p->ComputeDistinctiveDescriptor();
+      p->UpdateNormalAndDepth();
+    }
+  }
+  keyframe.UpdateConnections();
+}
+
+void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
+  // Gather the problem under the lock: keyframe + covisibles are free, keyframes that see the
+  // local points but are not local are fixed (the first keyframe is always fixed).
+  BundleAdjustmentProblem problem;
+  std::vector<std::shared_ptr<KeyFrame>> cameras;
+  std::vector<std::shared_ptr<MapPoint>> points;
+  std::vector<std::pair<KeyFrame*, size_t>> observation_refs;  // (keyframe, keypoint index)
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    if (keyframe.bad) return;
+    std::vector<KeyFrame*> local{&keyframe};
+    keyframe.ba_local_for = keyframe.id;
+    for (KeyFrame* kf : keyframe.ordered_connections) {
+      if (kf->bad || kf->ba_local_for == keyframe.id) continue;
+      kf->ba_local_for = keyframe.id;
+      local.push_back(kf);
+    }
+    std::sort(local.begin(), local.end(), KeyFrameIdLess());
+    std::vector<MapPoint*> local_points;
+    for (KeyFrame* kf : local) {
+      for (const auto& p : kf->map_points) {
+        if (!p || p->bad || p->ba_local_for == keyframe.id) continue;
+        p->ba_local_for = keyframe.id;
+        local_points.push_back(p.get());
+      }
+    }
+    std::sort(local_points.begin(), local_points.end(),
+              [](const MapPoint* a, const MapPoint* b) { return a->id < b->id; });
+    std::vector<KeyFrame*> fixed;
+    for (MapPoint* p : local_points) {
+      for (const auto& [kf, idx] : p->observations) {
+        if (kf->bad || kf->ba_local_for == keyframe.id || kf->ba_fixed_for == keyframe.id) continue;
+        kf->ba_fixed_for = keyframe.id;
+        fixed.push_back(kf);
+      }
+    }
+    std::sort(fixed.begin(), fixed.end(), KeyFrameIdLess());
+
+    std::map<const KeyFrame*, size_t> camera_index;
+    auto add_camera = [&](KeyFrame* kf, bool is_fixed) {
+      camera_index[kf] = problem.cameras.size();
+      problem.cameras.push_back({kf->cam_from_world, is_fixed || kf->id == 0});
+      cameras.push_back(map_.GetKeyFrame(kf->id));
+    };
+    for (KeyFrame* kf : local) add_camera(kf, false);
+    for (KeyFrame* kf : fixed) add_camera(kf, true);
+    bool any_free = false;
+    for (const BaCamera& c : problem.cameras) any_free = any_free || !c.fixed;
+    if (!any_free || local_points.empty()) return;
+    // The first keyframe alone fixed leaves the gauge free when nothing else is fixed; ORB-SLAM
+    // accepts that, but a fixed frame keeps repeated runs anchored.
+    problem.intrinsics = keyframe.F().intrinsics;
+    for (MapPoint* p : local_points) {
+      const size_t point_index = problem.points.size();
+      problem.points.push_back(p->position);
+      points.push_back(map_.GetMapPoint(p->id));
+      for (const auto& [kf, idx] : p->observations) {
+        auto it = camera_index.find(kf);
+        if (it == camera_index.end()) continue;
+        problem.observations.push_back({it->second, point_index, kf->F().Observation(idx)});
+        observation_refs.emplace_back(kf, idx);
+      }
+    }
+  }
+  for (const auto& c : cameras) {
+    if (!c) return;  // a keyframe was culled meanwhile (cannot happen in this thread)
+  }
+
+  const BundleAdjustmentResult result = SolveBundleAdjustment(problem, options_.ba);
+  ++num_ba_;
+
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  for (size_t i = 0; i < problem.observations.size(); ++i) {
+    if (!result.outlier[i]) continue;
+    auto [kf, idx] = observation_refs[i];
+    const std::shared_ptr<MapPoint>& point = points[problem.observations[i].point];
+    if (!point || point->bad || kf->bad) continue;
+    if (kf->map_points[idx] == point) kf->map_points[idx].reset();
+    point->EraseObservation(kf);
+    if (point->observations.empty()) map_.ErasePoint(point.get());
+  }
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    if (!problem.cameras[c].fixed && !cameras[c]->bad) cameras[c]->cam_from_world = result.cam_from_world[c];
+  }
+  for (size_t p = 0; p < points.size(); ++p) {
+    if (!points[p] || points[p]->bad) continue;
+    points[p]->position = result.points[p];
+    points[p]->UpdateNormalAndDepth();
+  }
+}
+
+void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
+  if (keyframe.bad) return;
+  for (KeyFrame* kf : std::vector<KeyFrame*>(keyframe.ordered_connections)) {
+    if (kf->id == 0 || kf->bad) continue;
+    int num_points = 0, num_redundant = 0;
+    for (size_t i = 0; i < kf->map_points.size(); ++i) {
+      const auto& p = kf->map_points[i];
+      if (!p || p->bad) continue;
+      // RGB-D: only close points count (far ones are not reliable enough to decide).
+      if (!kf->F().IsClose(i)) continue;
+      ++num_points;
+      if (p->NumObservations() <= options_.redundant_observers) continue;
+      const int level = kf->F().keypoints_un[i].octave;
+      int observers = 0;
+      for (const auto& [other, idx] : p->observations) {
+        if (other == kf) continue;
+        if (other->F().keypoints_un[idx].octave <= level + 1 && ++observers >= options_.redundant_observers) break;
+      }
+      if (observers >= options_.redundant_observers) ++num_redundant;
+    }
+    if (num_points > 0 && num_redundant > options_.redundant_ratio * num_points) map_.EraseKeyFrame(kf);
+  }
+}
+
+}  // namespace ademono

@@ -1,0 +1,63 @@
+#pragma once
+// Local mapping (ORB-SLAM's LocalMapping for RGB-D): for each new keyframe, registers its map
+// points, culls recently created points that are rarely found, fuses duplicates with the
+// covisible keyframes, runs a local bundle adjustment and culls redundant keyframes.
+//
+// Two modes: deterministic (InsertKeyFrame processes the keyframe before returning; outputs are
+// identical run to run) and threaded (a worker thread processes a queue while tracking
+// continues; the local BA is solved outside the map lock).
+
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "ademono/slam/map.h"
+#include "ademono/slam/options.h"
+
+namespace ademono {
+
+class LocalMapping {
+ public:
+  LocalMapping(Map& map, const MappingOptions& options);
+  ~LocalMapping();
+  LocalMapping(const LocalMapping&) = delete;
+  LocalMapping& operator=(const LocalMapping&) = delete;
+
+  // The caller must not hold map.mutex.
+  void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe);
+  // True when no keyframe is queued or being processed (always true in deterministic mode).
+  bool Idle() const;
+  size_t QueueSize() const;
+  // Blocks until the queue is empty (threaded mode), then stops the worker.
+  void Shutdown();
+  // Wall time of the last processed keyframe (ms) and of all of them.
+  double LastMilliseconds() const;
+  int NumLocalBundleAdjustments() const { return num_ba_; }
+
+ private:
+  void Run();
+  void Process(const std::shared_ptr<KeyFrame>& keyframe);
+  void ProcessNewKeyFrame(KeyFrame& keyframe);
+  void CullMapPoints(const KeyFrame& keyframe);
+  void FuseNeighbours(KeyFrame& keyframe);
+  void LocalBundleAdjustment(KeyFrame& keyframe);
+  void CullKeyFrames(KeyFrame& keyframe);
+
+  Map& map_;
+  MappingOptions options_;
+  std::vector<std::shared_ptr<MapPoint>> recent_points_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<std::shared_ptr<KeyFrame>> queue_;
+  bool busy_ = false;
+  bool stop_ = false;
+  double last_ms_ = 0;
+  int num_ba_ = 0;
+  std::thread worker_;
+};
+
+}  // namespace ademono

@@ -1,0 +1,129 @@
+#include "ademono/slam/map.h"
+
+namespace ademono {
+
+std::shared_ptr<KeyFrame> Map::CreateKeyFrame(const Frame& frame) {
+  auto kf = std::make_shared<KeyFrame>(next_keyframe_id_++, frame);
+  keyframes_[kf->id] = kf;
+  return kf;
+}
+
+std::shared_ptr<MapPoint> Map::CreateMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
+                                              uint64_t frame_id) {
+  auto p = std::make_shared<MapPoint>(next_point_id_++, position, reference, frame_id);
+  points_[p->id] = p;
+  return p;
+}
+
+void Map::ErasePoint(MapPoint* point) {
+  if (point == nullptr || point->bad) return;
+  point->bad = true;
+  const auto observations = point->observations;
+  point->observations.clear();
+  for (const auto& [kf, idx] : observations) {
+    if (idx < kf->map_points.size() && kf->map_points[idx].get() == point) kf->map_points[idx].reset();
+  }
+  points_.erase(point->id);
+}
+
+void Map::ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new_point) {
+  if (old_point == nullptr || old_point == new_point.get() || old_point->bad) return;
+  const auto observations = old_point->observations;
+  old_point->observations.clear();
+  old_point->bad = true;
+  old_point->replaced_by = new_point;
+  for (const auto& [kf, idx] : observations) {
+    if (!new_point->IsInKeyFrame(kf)) {
+      kf->map_points[idx] = new_point;
+      new_point->AddObservation(kf, idx);
+    } else {
+      kf->map_points[idx].reset();
+    }
+  }
+  new_point->found += old_point->found;
+  new_point->visible += old_point->visible;
+  new_point->ComputeDistinctiveDescriptor();
+  points_.erase(old_point->id);
+}
+
+void Map::EraseKeyFrame(KeyFrame* keyframe) {
+  if (keyframe == nullptr || keyframe->bad || keyframe->id == 0) return;
+  for (KeyFrame* other : std::vector<KeyFrame*>(keyframe->ordered_connections)) {
+    other->EraseConnection(keyframe);
+  }
+  for (auto& p : keyframe->map_points) {
+    if (!p) continue;
+    MapPoint* point = p.get();
+    p.reset();
+    point->EraseObservation(keyframe);
+    if (point->observations.empty()) {
+      ErasePoint(point);
+    } else if (!point->bad) {
+      point->UpdateNormalAndDepth();
+    }
+  }
+  keyframe->connections.clear();
+  keyframe->ordered_connections.clear();
+
+  // Re-parent the children: each picks its strongest covisible link among the candidates,
+  // starting from this keyframe's parent (ORB-SLAM's spanning tree update, simplified).
+  std::set<KeyFrame*, KeyFrameIdLess> candidates;
+  if (keyframe->parent != nullptr) candidates.insert(keyframe->parent);
+  std::set<KeyFrame*, KeyFrameIdLess> children = keyframe->children;
+  while (!children.empty()) {
+    KeyFrame* best_child = nullptr;
+    KeyFrame* best_parent = nullptr;
+    int best_weight = -1;
+    for (KeyFrame* child : children) {
+      for (const auto& [kf, w] : child->connections) {
+        if (candidates.count(kf) > 0 && w > best_weight) {
+          best_weight = w;
+          best_child = child;
+          best_parent = kf;
+        }
+      }
+    }
+    if (best_child == nullptr) break;
+    best_child->parent = best_parent;
+    best_parent->children.insert(best_child);
+    candidates.insert(best_child);
+    children.erase(best_child);
+  }
+  for (KeyFrame* child : children) {
+    child->parent = keyframe->parent;
+    if (keyframe->parent != nullptr) keyframe->parent->children.insert(child);
+  }
+  if (keyframe->parent != nullptr) {
+    keyframe->parent->children.erase(keyframe);
+    keyframe->cam_from_parent = keyframe->cam_from_world * keyframe->parent->cam_from_world.inverse();
+  }
+  keyframe->children.clear();
+  keyframe->bad = true;
+  auto it = keyframes_.find(keyframe->id);
+  if (it != keyframes_.end()) {
+    graveyard_.push_back(it->second);
+    keyframes_.erase(it);
+  }
+}
+
+std::shared_ptr<KeyFrame> Map::GetKeyFrame(uint64_t id) const {
+  auto it = keyframes_.find(id);
+  return it == keyframes_.end() ? nullptr : it->second;
+}
+
+std::shared_ptr<MapPoint> Map::GetMapPoint(uint64_t id) const {
+  auto it = points_.find(id);
+  return it == points_.end() ? nullptr : it->second;
+}
+
+Rigid3d Map::ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe) {
+  Rigid3d cam_from_kf = cam_from_keyframe;
+  int guard = 0;
+  while (keyframe->bad && keyframe->parent != nullptr && guard++ < 10000) {
+    cam_from_kf = cam_from_kf * keyframe->cam_from_parent;
+    keyframe = keyframe->parent;
+  }
+  return cam_from_kf * keyframe->cam_from_world;
+}
+
+}  // namespace ademono

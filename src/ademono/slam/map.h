@@ -1,0 +1,55 @@
+#pragma once
+// The map database: keyframes and map points, owned here by shared_ptr. Culled keyframes move
+// to a graveyard so raw KeyFrame* links (observations, spanning tree) never dangle and culled
+// keyframes can still resolve the poses of frames that referenced them.
+//
+// Locking: `mutex` guards every KeyFrame and MapPoint. Tracking holds it for a whole frame;
+// local mapping holds it for each step and releases it while Ceres solves a local BA on copies.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "ademono/slam/keyframe.h"
+#include "ademono/slam/map_point.h"
+
+namespace ademono {
+
+class Map {
+ public:
+  std::mutex mutex;
+
+  std::shared_ptr<KeyFrame> CreateKeyFrame(const Frame& frame);
+  std::shared_ptr<MapPoint> CreateMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
+                                           uint64_t frame_id);
+  void AddMapPoint(const std::shared_ptr<MapPoint>& point) { points_[point->id] = point; }
+
+  // Marks the point bad, removes its observations and drops it from the map.
+  void ErasePoint(MapPoint* point);
+  // ORB-SLAM's MapPoint::Replace: `old_point`'s observations move to `new_point`.
+  void ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new_point);
+  // ORB-SLAM's KeyFrame::SetBadFlag: removes the keyframe, its observations and edges and
+  // re-parents its children in the spanning tree. The first keyframe is never removed.
+  void EraseKeyFrame(KeyFrame* keyframe);
+
+  std::shared_ptr<KeyFrame> GetKeyFrame(uint64_t id) const;
+  std::shared_ptr<MapPoint> GetMapPoint(uint64_t id) const;
+  const std::map<uint64_t, std::shared_ptr<KeyFrame>>& KeyFrames() const { return keyframes_; }
+  const std::map<uint64_t, std::shared_ptr<MapPoint>>& MapPoints() const { return points_; }
+  size_t NumKeyFrames() const { return keyframes_.size(); }
+  size_t NumMapPoints() const { return points_.size(); }
+  uint64_t NextKeyFrameId() const { return next_keyframe_id_; }
+  // Pose of a (possibly culled) keyframe resolved through the spanning tree: cam_from_world.
+  static Rigid3d ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe);
+
+ private:
+  std::map<uint64_t, std::shared_ptr<KeyFrame>> keyframes_;
+  std::map<uint64_t, std::shared_ptr<MapPoint>> points_;
+  std::vector<std::shared_ptr<KeyFrame>> graveyard_;
+  uint64_t next_keyframe_id_ = 0;
+  uint64_t next_point_id_ = 0;
+};
+
+}  // namespace ademono

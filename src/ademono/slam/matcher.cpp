@@ -1,0 +1,308 @@
+#include "ademono/slam/matcher.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <opencv2/features2d.hpp>
+
+#include "ademono/feature/orb_extractor.h"
+
+namespace ademono {
+namespace {
+
+float AngleDiff(float a, float b) {
+  float rot = a - b;
+  if (rot < 0.f) rot += 360.f;
+  return rot;
+}
+
+}  // namespace
+
+std::vector<size_t> Matcher::RotationOutliers(const std::vector<std::pair<size_t, float>>& rotations) {
+  std::array<std::vector<size_t>, kHistogramBins> bins;
+  const float factor = kHistogramBins / 360.f;
+  for (const auto& [idx, rot] : rotations) {
+    int bin = static_cast<int>(std::round(rot * factor));
+    if (bin == kHistogramBins) bin = 0;
+    bin = std::clamp(bin, 0, kHistogramBins - 1);
+    bins[bin].push_back(idx);
+  }
+  // The three fullest bins; a bin with less than 10% of the first is dropped (ORB-SLAM).
+  int i1 = -1, i2 = -1, i3 = -1;
+  size_t m1 = 0, m2 = 0, m3 = 0;
+  for (int i = 0; i < kHistogramBins; ++i) {
+    const size_t s = bins[i].size();
+    if (s > m1) {
+      m3 = m2; i3 = i2; m2 = m1; i2 = i1; m1 = s; i1 = i;
+    } else if (s > m2) {
+      m3 = m2; i3 = i2; m2 = s; i2 = i;
+    } else if (s > m3) {
+      m3 = s; i3 = i;
+    }
+  }
+  if (m2 < 0.1 * m1) i2 = i3 = -1;
+  else if (m3 < 0.1 * m1) i3 = -1;
+  std::vector<size_t> outliers;
+  for (int i = 0; i < kHistogramBins; ++i) {
+    if (i == i1 || i == i2 || i == i3) continue;
+    outliers.insert(outliers.end(), bins[i].begin(), bins[i].end());
+  }
+  return outliers;
+}
+
+int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius) const {
+  const FrameFeatures& cf = current.F();
+  const FrameFeatures& lf = last.F();
+  const Rigid3d& cam_from_world = *current.cam_from_world;
+  // Moving forward, points grow in the image (appear on finer levels); backward, coarser.
+  const Eigen::Vector3d last_from_current_t = (*last.cam_from_world * cam_from_world.inverse()).translation();
+  const double baseline = cf.intrinsics.bf / cf.intrinsics.fx;
+  const bool forward = last_from_current_t.z() > baseline;
+  const bool backward = -last_from_current_t.z() > baseline;
+
+  std::vector<std::pair<size_t, float>> rotations;
+  int matches = 0;
+  for (size_t i = 0; i < last.map_points.size(); ++i) {
+    const auto& point = last.map_points[i];
+    if (!point || last.outlier[i] || point->bad) continue;
+    const Eigen::Vector3d pc = cam_from_world * point->position;
+    if (pc.z() <= 0) continue;
+    const double inv_z = 1.0 / pc.z();
+    const float u = static_cast<float>(cf.intrinsics.fx * pc.x() * inv_z + cf.intrinsics.cx);
+    const float v = static_cast<float>(cf.intrinsics.fy * pc.y() * inv_z + cf.intrinsics.cy);
+    if (!cf.InBounds(u, v)) continue;
+    const int last_octave = lf.keypoints_un[i].octave;
+    const float r = radius * cf.pyramid->scale_factors[last_octave];
+    std::vector<size_t> candidates;
+    if (forward) {
+      candidates = cf.FeaturesInArea(u, v, r, last_octave);
+    } else if (backward) {
+      candidates = cf.FeaturesInArea(u, v, r, 0, last_octave);
+    } else {
+      candidates = cf.FeaturesInArea(u, v, r, last_octave - 1, last_octave + 1);
+    }
+    const float ur = static_cast<float>(u - cf.intrinsics.bf * inv_z);
+    int best_dist = 256;
+    size_t best_idx = 0;
+    for (size_t idx : candidates) {
+      if (current.map_points[idx] && current.map_points[idx]->NumObservations() > 0) continue;
+      if (cf.u_right[idx] > 0 && std::abs(ur - cf.u_right[idx]) > r) continue;
+      const int d = DescriptorDistance(point->descriptor, cf.descriptors.row(static_cast<int>(idx)));
+      if (d < best_dist) {
+        best_dist = d;
+        best_idx = idx;
+      }
+    }
+    if (best_dist <= kThHigh) {
+      current.map_points[best_idx] = point;
+      ++matches;
+      if (check_orientation_) {
+        rotations.emplace_back(best_idx, AngleDiff(lf.keypoints[i].angle, cf.keypoints[best_idx].angle));
+      }
+    }
+  }
+  if (check_orientation_) {
+    for (size_t idx : RotationOutliers(rotations)) {
+      current.map_points[idx].reset();
+      --matches;
+    }
+  }
+  return matches;
+}
+
+int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<MapPoint>>& points,
+                                const std::vector<ProjectionPrediction>& predictions, float radius) const {
+  const FrameFeatures& f = frame.F();
+  int matches = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const auto& point = points[k];
+    if (point->bad) continue;
+    const ProjectionPrediction& pred = predictions[k];
+    const int level = pred.level;
+    const float r = radius * RadiusByViewingCos(pred.view_cos) * f.pyramid->scale_factors[level];
+    const std::vector<size_t> candidates = f.FeaturesInArea(pred.u, pred.v, r, level - 1, level);
+    int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
+    size_t best_idx = 0;
+    for (size_t idx : candidates) {
+      if (frame.map_points[idx] && frame.map_points[idx]->NumObservations() > 0) continue;
+      if (f.u_right[idx] > 0 && std::abs(pred.u_right - f.u_right[idx]) > r * f.pyramid->scale_factors[level]) {
+        continue;
+      }
+      const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
+      if (d < best_dist) {
+        best_dist2 = best_dist;
+        best_level2 = best_level;
+        best_dist = d;
+        best_level = f.keypoints_un[idx].octave;
+        best_idx = idx;
+      } else if (d < best_dist2) {
+        best_dist2 = d;
+        best_level2 = f.keypoints_un[idx].octave;
+      }
+    }
+    if (best_dist <= kThHigh) {
+      if (best_level == best_level2 && best_dist > nn_ratio_ * best_dist2) continue;
+      frame.map_points[best_idx] = point;
+      ++matches;
+    }
+  }
+  return matches;
+}
+
+int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius, int max_distance) const {
+  const FrameFeatures& f = frame.F();
+  const Rigid3d& cam_from_world = *frame.cam_from_world;
+  const Eigen::Vector3d center = frame.CameraCenter();
+  std::vector<std::pair<size_t, float>> rotations;
+  int matches = 0;
+  for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
+    const auto& point = keyframe.map_points[i];
+    if (!point || point->bad) continue;
+    if (std::find(frame.map_points.begin(), frame.map_points.end(), point) != frame.map_points.end()) continue;
+    const Eigen::Vector3d pc = cam_from_world * point->position;
+    if (pc.z() <= 0) continue;
+    const float u = static_cast<float>(f.intrinsics.fx * pc.x() / pc.z() + f.intrinsics.cx);
+    const float v = static_cast<float>(f.intrinsics.fy * pc.y() / pc.z() + f.intrinsics.cy);
+    if (!f.InBounds(u, v)) continue;
+    const float dist = static_cast<float>((point->position - center).norm());
+    if (dist < 0.8f * point->min_distance || dist > 1.2f * point->max_distance) continue;
+    const int level = point->PredictScale(dist, f.pyramid->log_scale_factor, f.pyramid->num_levels);
+    const float r = radius * f.pyramid->scale_factors[level];
+    int best_dist = 256;
+    size_t best_idx = 0;
+    for (size_t idx : f.FeaturesInArea(u, v, r, level - 1, level + 1)) {
+      if (frame.map_points[idx]) continue;
+      const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
+      if (d < best_dist) {
+        best_dist = d;
+        best_idx = idx;
+      }
+    }
+    if (best_dist <= max_distance) {
+      frame.map_points[best_idx] = point;
+      ++matches;
+      if (check_orientation_) {
+        rotations.emplace_back(best_idx, AngleDiff(keyframe.F().keypoints[i].angle, f.keypoints[best_idx].angle));
+      }
+    }
+  }
+  if (check_orientation_) {
+    for (size_t idx : RotationOutliers(rotations)) {
+      frame.map_points[idx].reset();
+      --matches;
+    }
+  }
+  return matches;
+}
+
+int Matcher::SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
+                                std::vector<std::shared_ptr<MapPoint>>& matches) const {
+  const FrameFeatures& kf = keyframe.F();
+  const FrameFeatures& f = frame.F();
+  matches.assign(f.Size(), nullptr);
+  std::vector<size_t> kf_indices;
+  for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
+    if (keyframe.map_points[i] && !keyframe.map_points[i]->bad) kf_indices.push_back(i);
+  }
+  if (kf_indices.empty() || f.Size() == 0) return 0;
+
+  cv::Mat kf_descriptors(static_cast<int>(kf_indices.size()), 32, CV_8UC1);
+  for (size_t k = 0; k < kf_indices.size(); ++k) {
+    kf.descriptors.row(static_cast<int>(kf_indices[k])).copyTo(kf_descriptors.row(static_cast<int>(k)));
+  }
+  // For every frame keypoint its two nearest keyframe keypoints (OpenCV's brute force).
+  cv::BFMatcher bf(cv::NORM_HAMMING);
+  std::vector<std::vector<cv::DMatch>> knn;
+  bf.knnMatch(f.descriptors, kf_descriptors, knn, 2);
+  std::vector<int> best_for_kf(kf_indices.size(), 256);
+  std::vector<int> best_frame_for_kf(kf_indices.size(), -1);
+  for (const auto& m : knn) {
+    if (m.empty()) continue;
+    const int best = static_cast<int>(m[0].distance);
+    const int second = m.size() > 1 ? static_cast<int>(m[1].distance) : 256;
+    if (best > kThLow || best >= nn_ratio_ * second) continue;
+    const size_t best_k = static_cast<size_t>(m[0].trainIdx);
+    // Keep one frame keypoint per keyframe keypoint: the closest (lowest index on ties).
+    if (best < best_for_kf[best_k]) {
+      best_for_kf[best_k] = best;
+      best_frame_for_kf[best_k] = m[0].queryIdx;
+    }
+  }
+  std::vector<std::pair<size_t, float>> rotations;
+  int n = 0;
+  for (size_t k = 0; k < kf_indices.size(); ++k) {
+    if (best_frame_for_kf[k] < 0) continue;
+    const size_t j = static_cast<size_t>(best_frame_for_kf[k]);
+    matches[j] = keyframe.map_points[kf_indices[k]];
+    ++n;
+    rotations.emplace_back(j, AngleDiff(kf.keypoints[kf_indices[k]].angle, f.keypoints[j].angle));
+  }
+  if (check_orientation_) {
+    for (size_t j : RotationOutliers(rotations)) {
+      matches[j].reset();
+      --n;
+    }
+  }
+  return n;
+}
+
+int Matcher::Fuse(Map& map, KeyFrame& keyframe, const std::vector<std::shared_ptr<MapPoint>>& points,
+                  float radius) const {
+  const FrameFeatures& f = keyframe.F();
+  const Rigid3d& cam_from_world = keyframe.cam_from_world;
+  const Eigen::Vector3d center = keyframe.CameraCenter();
+  int fused = 0;
+  for (const auto& point : points) {
+    if (!point || point->bad || point->IsInKeyFrame(&keyframe)) continue;
+    const Eigen::Vector3d pc = cam_from_world * point->position;
+    if (pc.z() <= 0) continue;
+    const double inv_z = 1.0 / pc.z();
+    const float u = static_cast<float>(f.intrinsics.fx * pc.x() * inv_z + f.intrinsics.cx);
+    const float v = static_cast<float>(f.intrinsics.fy * pc.y() * inv_z + f.intrinsics.cy);
+    if (!f.InBounds(u, v)) continue;
+    const float ur = static_cast<float>(u - f.intrinsics.bf * inv_z);
+    const Eigen::Vector3d po = point->position - center;
+    const float dist = static_cast<float>(po.norm());
+    if (dist < 0.8f * point->min_distance || dist > 1.2f * point->max_distance) continue;
+    if (po.dot(point->normal) < 0.5 * dist) continue;
+    const int level = point->PredictScale(dist, f.pyramid->log_scale_factor, f.pyramid->num_levels);
+    const float r = radius * f.pyramid->scale_factors[level];
+    int best_dist = 256;
+    size_t best_idx = 0;
+    for (size_t idx : f.FeaturesInArea(u, v, r)) {
+      const cv::KeyPoint& kp = f.keypoints_un[idx];
+      if (kp.octave < level - 1 || kp.octave > level) continue;
+      const float ex = u - kp.pt.x, ey = v - kp.pt.y;
+      float e2 = ex * ex + ey * ey;
+      double th = kChi2Mono;
+      if (f.u_right[idx] >= 0) {
+        const float er = ur - f.u_right[idx];
+        e2 += er * er;
+        th = kChi2Stereo;
+      }
+      if (e2 * f.pyramid->inv_level_sigma2[kp.octave] > th) continue;
+      const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
+      if (d < best_dist) {
+        best_dist = d;
+        best_idx = idx;
+      }
+    }
+    if (best_dist > kThLow) continue;
+    const std::shared_ptr<MapPoint> existing = keyframe.map_points[best_idx];
+    if (existing && !existing->bad) {
+      if (existing->NumObservations() > point->NumObservations()) {
+        map.ReplacePoint(point.get(), existing);
+      } else {
+        map.ReplacePoint(existing.get(), point);
+      }
+    } else {
+      point->AddObservation(&keyframe, best_idx);
+      keyframe.AddMapPoint(point, best_idx);
+    }
+    ++fused;
+  }
+  return fused;
+}
+
+}  // namespace ademono

@@ -1,0 +1,58 @@
+#pragma once
+// Descriptor matching for tracking and mapping (after ORB-SLAM's ORBmatcher): search by
+// projection with a window radius by scale level (and viewing angle), Hamming thresholds, a
+// ratio test between the two best candidates and rotation consistency (a 30-bin histogram of
+// keypoint angle differences; only the three fullest bins are kept).
+
+#include <memory>
+#include <vector>
+
+#include "ademono/slam/frame.h"
+#include "ademono/slam/keyframe.h"
+#include "ademono/slam/map.h"
+
+namespace ademono {
+
+class Matcher {
+ public:
+  static constexpr int kThHigh = 100;
+  static constexpr int kThLow = 50;
+  static constexpr int kHistogramBins = 30;
+
+  Matcher(float nn_ratio, bool check_orientation) : nn_ratio_(nn_ratio), check_orientation_(check_orientation) {}
+
+  // Constant-velocity tracking: map points of `last` projected into `current` (whose pose is
+  // the prediction). Returns the number of new matches written into current.map_points.
+  int SearchByProjection(Frame& current, const Frame& last, float radius) const;
+
+  // Local-map tracking: `points` with their predictions (from Frame::InFrustum).
+  int SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<MapPoint>>& points,
+                         const std::vector<ProjectionPrediction>& predictions, float radius) const;
+
+  // Relocalisation: map points of `keyframe` not yet in `found` projected into `frame`.
+  int SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius, int max_distance) const;
+
+  // Descriptor matching (brute force, ratio test, rotation check) of the frame's keypoints
+  // against the keyframe's keypoints that have map points: writes the matches into `matches`
+  // (one map point or null per frame keypoint). Used when the motion model fails and to
+  // relocalise. Returns the number of matches.
+  int SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
+                         std::vector<std::shared_ptr<MapPoint>>& matches) const;
+
+  // Fusion: projects `points` into `keyframe`; a point matching a keypoint that already has a
+  // map point is merged with it (the one with fewer observations is replaced), otherwise it gets
+  // the new observation. Returns the number of fused points.
+  int Fuse(Map& map, KeyFrame& keyframe, const std::vector<std::shared_ptr<MapPoint>>& points,
+           float radius) const;
+
+  static float RadiusByViewingCos(float view_cos) { return view_cos > 0.998f ? 2.5f : 4.0f; }
+
+ private:
+  // Indices of the matches to drop because their rotation is not among the 3 main bins.
+  static std::vector<size_t> RotationOutliers(const std::vector<std::pair<size_t, float>>& rotations);
+
+  float nn_ratio_;
+  bool check_orientation_;
+};
+
+}  // namespace ademono

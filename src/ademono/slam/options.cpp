@@ -1,0 +1,171 @@
+#include "ademono/slam/options.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "ademono/core/error.h"
+
+namespace ademono {
+namespace {
+
+template <typename T>
+void Read(const YAML::Node& node, const char* key, T& value) {
+  if (!node || !node[key]) return;
+  try {
+    value = node[key].as<T>();
+  } catch (const YAML::Exception&) {
+    throw std::invalid_argument(std::string("'") + key + "' has the wrong type");
+  }
+}
+
+void Require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument(message);
+}
+
+void CheckKnownKeys(const YAML::Node& node, const char* section,
+                    std::initializer_list<const char*> keys) {
+  if (!node) return;
+  if (!node.IsMap()) throw std::invalid_argument(std::string("'") + section + "' must be a map");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    bool known = false;
+    for (const char* k : keys) known = known || key == k;
+    if (!known) throw std::invalid_argument(std::string("unknown key '") + section + "." + key + "'");
+  }
+}
+
+}  // namespace
+
+void FrameDepthOptions::Check() const {
+  Require(min_depth >= 0 && max_depth > min_depth, "depth: need 0 <= min_depth < max_depth");
+  Require(virtual_baseline > 0, "depth: virtual_baseline must be > 0");
+  Require(close_depth_factor > 0, "depth: close_depth_factor must be > 0");
+  Require(edge_radius >= 0 && edge_radius <= 10, "depth: edge_radius must be in [0, 10]");
+  Require(edge_relative_jump > 0, "depth: edge_relative_jump must be > 0");
+}
+
+FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
+  CheckKnownKeys(node, "depth",
+                 {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor",
+                  "edge_radius", "edge_relative_jump"});
+  FrameDepthOptions o;
+  Read(node, "min_depth", o.min_depth);
+  Read(node, "max_depth", o.max_depth);
+  Read(node, "virtual_baseline", o.virtual_baseline);
+  Read(node, "close_depth_factor", o.close_depth_factor);
+  Read(node, "edge_radius", o.edge_radius);
+  Read(node, "edge_relative_jump", o.edge_relative_jump);
+  o.Check();
+  return o;
+}
+
+void TrackingOptions::Check() const {
+  Require(min_init_points >= 10, "tracking: min_init_points must be >= 10");
+  Require(motion_search_radius > 0 && local_search_radius > 0, "tracking: search radii must be > 0");
+  Require(min_motion_matches > 0 && min_inliers > 0 && min_inliers_after_reloc > 0,
+          "tracking: match thresholds must be > 0");
+  Require(max_local_keyframes > 0, "tracking: max_local_keyframes must be > 0");
+  Require(min_frames_between_keyframes >= 0 &&
+              max_frames_between_keyframes >= min_frames_between_keyframes,
+          "tracking: need 0 <= min_frames_between_keyframes <= max_frames_between_keyframes");
+  Require(keyframe_ref_ratio > 0 && keyframe_ref_ratio <= 1, "tracking: keyframe_ref_ratio in (0, 1]");
+  Require(close_tracked_min >= 0 && close_untracked_min >= 0 && new_keyframe_min_points >= 0,
+          "tracking: close point counts must be >= 0");
+  Require(relocalisation_keyframes > 0, "tracking: relocalisation_keyframes must be > 0");
+  Require(reinit_after_lost_frames >= 0, "tracking: reinit_after_lost_frames must be >= 0");
+  Require(dynamic_cull_hits > 0, "tracking: dynamic_cull_hits must be > 0");
+}
+
+TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
+  CheckKnownKeys(node, "tracking",
+                 {"min_init_points", "motion_search_radius", "min_motion_matches",
+                  "local_search_radius", "min_inliers", "min_inliers_after_reloc",
+                  "max_local_keyframes", "min_frames_between_keyframes",
+                  "max_frames_between_keyframes", "keyframe_ref_ratio", "close_tracked_min",
+                  "close_untracked_min", "new_keyframe_min_points", "relocalisation_keyframes",
+                  "reinit_after_lost_frames", "dynamic_cull_hits"});
+  TrackingOptions o;
+  Read(node, "min_init_points", o.min_init_points);
+  Read(node, "motion_search_radius", o.motion_search_radius);
+  Read(node, "min_motion_matches", o.min_motion_matches);
+  Read(node, "local_search_radius", o.local_search_radius);
+  Read(node, "min_inliers", o.min_inliers);
+  Read(node, "min_inliers_after_reloc", o.min_inliers_after_reloc);
+  Read(node, "max_local_keyframes", o.max_local_keyframes);
+  Read(node, "min_frames_between_keyframes", o.min_frames_between_keyframes);
+  Read(node, "max_frames_between_keyframes", o.max_frames_between_keyframes);
+  Read(node, "keyframe_ref_ratio", o.keyframe_ref_ratio);
+  Read(node, "close_tracked_min", o.close_tracked_min);
+  Read(node, "close_untracked_min", o.close_untracked_min);
+  Read(node, "new_keyframe_min_points", o.new_keyframe_min_points);
+  Read(node, "relocalisation_keyframes", o.relocalisation_keyframes);
+  Read(node, "reinit_after_lost_frames", o.reinit_after_lost_frames);
+  Read(node, "dynamic_cull_hits", o.dynamic_cull_hits);
+  o.Check();
+  return o;
+}
+
+void MappingOptions::Check() const {
+  Require(cull_found_ratio >= 0 && cull_found_ratio < 1, "mapping: cull_found_ratio in [0, 1)");
+  Require(cull_min_observations >= 1, "mapping: cull_min_observations must be >= 1");
+  Require(fuse_neighbours >= 0 && fuse_radius > 0, "mapping: fuse settings must be positive");
+  Require(redundant_ratio > 0 && redundant_ratio <= 1, "mapping: redundant_ratio in (0, 1]");
+  Require(redundant_observers >= 1, "mapping: redundant_observers must be >= 1");
+  ba.Check();
+}
+
+MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
+  CheckKnownKeys(node, "mapping",
+                 {"deterministic", "local_ba", "cull_found_ratio", "cull_min_observations",
+                  "fuse_neighbours", "fuse_radius", "redundant_ratio", "redundant_observers",
+                  "ba_first_iterations", "ba_second_iterations"});
+  MappingOptions o;
+  Read(node, "deterministic", o.deterministic);
+  Read(node, "local_ba", o.local_ba);
+  Read(node, "cull_found_ratio", o.cull_found_ratio);
+  Read(node, "cull_min_observations", o.cull_min_observations);
+  Read(node, "fuse_neighbours", o.fuse_neighbours);
+  Read(node, "fuse_radius", o.fuse_radius);
+  Read(node, "redundant_ratio", o.redundant_ratio);
+  Read(node, "redundant_observers", o.redundant_observers);
+  Read(node, "ba_first_iterations", o.ba.first_iterations);
+  Read(node, "ba_second_iterations", o.ba.second_iterations);
+  o.Check();
+  return o;
+}
+
+void SystemOptions::Check() const {
+  orb.Check();
+  filter.Check();
+  depth.Check();
+  tracking.Check();
+  mapping.Check();
+  pose.Check();
+}
+
+SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesystem::path& path) {
+  SystemOptions o;
+  try {
+    if (root && !root.IsNull() && !root.IsMap()) throw std::invalid_argument("root must be a map");
+    CheckKnownKeys(root, "(root)",
+                   {"camera", "orb", "filter", "depth", "tracking", "mapping", "optimizer",
+                    "run", "dataset", "detector"});
+    if (root["orb"]) o.orb = OrbOptions::FromYaml(root["orb"]);
+    if (root["filter"]) o.filter = FilterOptions::FromYaml(root["filter"]);
+    o.depth = FrameDepthOptions::FromYaml(root["depth"]);
+    o.tracking = TrackingOptions::FromYaml(root["tracking"]);
+    o.mapping = MappingOptions::FromYaml(root["mapping"]);
+    const YAML::Node optimizer = root["optimizer"];
+    CheckKnownKeys(optimizer, "optimizer", {"pose_rounds", "pose_iterations_per_round"});
+    Read(optimizer, "pose_rounds", o.pose.rounds);
+    Read(optimizer, "pose_iterations_per_round", o.pose.iterations_per_round);
+    o.Check();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    ThrowInputError(path, e.what());
+  }
+  return o;
+}
+
+}  // namespace ademono

@@ -1,0 +1,449 @@
+#include "ademono/slam/tracking.h"
+
+#include <algorithm>
+#include <map>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "ademono/optimize/pose_optimizer.h"
+#include "ademono/slam/matcher.h"
+
+namespace ademono {
+
+Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
+    : map_(map), local_mapping_(local_mapping), options_(options) {}
+
+std::optional<Rigid3d> Tracking::PredictNext() const {
+  if (state_ != TrackingState::kOk || !last_frame_ || !last_frame_->cam_from_world || !velocity_) {
+    return std::nullopt;
+  }
+  return *velocity_ * *last_frame_->cam_from_world;
+}
+
+int Tracking::CountDepthPoints(const Frame& frame) const {
+  int n = 0;
+  for (float d : frame.F().depth) n += d > 0 ? 1 : 0;
+  return n;
+}
+
+TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
+                               double timestamp, const std::vector<Detection>& detections) {
+  Frame frame(next_frame_id_++, index, timestamp, std::move(features));
+  TrackingOutput out;
+  bool ok = false;
+
+  if (state_ == TrackingState::kNotInitialized) {
+    ok = Initialise(frame, Rigid3d::Identity());
+    if (ok) out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
+  } else {
+    // Fusion in local mapping may have replaced points the last frame still holds.
+    if (last_frame_) {
+      for (auto& p : last_frame_->map_points) {
+        if (p && p->replaced_by) p = MapPoint::Resolve(p);
+        if (p && p->bad) p.reset();
+      }
+    }
+    if (state_ == TrackingState::kOk) {
+      if (velocity_ && frame.id >= last_reloc_frame_id_ + 2) {
+        ok = TrackWithMotionModel(frame);
+        if (!ok) ok = TrackReferenceKeyFrame(frame);
+      } else {
+        ok = TrackReferenceKeyFrame(frame);
+      }
+    } else {
+      ok = Relocalise(frame);
+      out.relocalised = ok;
+    }
+    frame.reference_keyframe = reference_keyframe_;
+    if (ok) ok = TrackLocalMap(frame, detections, &out.dynamic_points_culled);
+
+    if (ok) {
+      if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
+        velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
+      } else {
+        velocity_.reset();
+      }
+      state_ = TrackingState::kOk;
+      lost_streak_ = 0;
+      if (NeedNewKeyFrame(frame)) out.new_keyframe = CreateNewKeyFrame(frame);
+      // Outliers do not carry over to the next frame's motion-model search.
+      for (size_t i = 0; i < frame.map_points.size(); ++i) {
+        if (frame.map_points[i] && frame.outlier[i]) frame.map_points[i].reset();
+      }
+    } else {
+      state_ = TrackingState::kLost;
+      velocity_.reset();
+      ++lost_streak_;
+      // After a long loss, restart from the last known pose in the same map rather than
+      // dropping every following frame (drift instead of a gap).
+      if (lost_streak_ > options_.tracking.reinit_after_lost_frames && last_good_pose_ &&
+          CountDepthPoints(frame) >= options_.tracking.min_init_points) {
+        frame.map_points.assign(frame.F().Size(), nullptr);
+        ok = Initialise(frame, *last_good_pose_);
+        if (ok) {
+          out.reinitialised = true;
+          out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
+        }
+      }
+    }
+  }
+
+  FrameRecord record;
+  record.index = index;
+  record.timestamp = timestamp;
+  record.tracked = ok;
+  if (ok) {
+    if (out.relocalised) ++num_relocalisations_;
+    last_good_pose_ = *frame.cam_from_world;
+    record.reference = frame.reference_keyframe;
+    record.cam_from_reference = *frame.cam_from_world * frame.reference_keyframe->cam_from_world.inverse();
+    out.tracked = true;
+    out.cam_from_world = *frame.cam_from_world;
+    out.inliers = matches_inliers_;
+  } else if (state_ != TrackingState::kNotInitialized) {
+    ++num_lost_;
+  }
+  records_.push_back(record);
+  if (ok) {
+    last_frame_ = std::move(frame);
+  } else if (state_ != TrackingState::kNotInitialized) {
+    last_frame_.reset();
+  }
+  return out;
+}
+
+bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
+  if (CountDepthPoints(frame) < options_.tracking.min_init_points) return false;
+  frame.cam_from_world = cam_from_world;
+  std::shared_ptr<KeyFrame> kf = map_.CreateKeyFrame(frame);
+  const Rigid3d world_from_cam = cam_from_world.inverse();
+  const FrameFeatures& f = frame.F();
+  for (size_t i = 0; i < f.Size(); ++i) {
+    if (f.depth[i] <= 0) continue;
+    auto point = map_.CreateMapPoint(world_from_cam * f.UnprojectCamera(i), kf.get(), frame.id);
+    point->AddObservation(kf.get(), i);
+    kf->AddMapPoint(point, i);
+    point->ComputeDistinctiveDescriptor();
+    point->UpdateNormalAndDepth();
+    frame.map_points[i] = point;
+  }
+  frame.reference_keyframe = kf.get();
+  reference_keyframe_ = kf.get();
+  last_keyframe_frame_id_ = frame.id;
+  local_keyframes_ = {kf.get()};
+  local_points_.clear();
+  for (const auto& p : kf->map_points) {
+    if (p) local_points_.push_back(p);
+  }
+  velocity_.reset();
+  state_ = TrackingState::kOk;
+  matches_inliers_ = static_cast<int>(local_points_.size());
+  return true;
+}
+
+int Tracking::OptimizeFramePose(Frame& frame) {
+  std::vector<PoseObservation> observations;
+  std::vector<size_t> indices;
+  const FrameFeatures& f = frame.F();
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad) continue;
+    observations.push_back({p->position, f.Observation(i)});
+    indices.push_back(i);
+  }
+  for (size_t i = 0; i < frame.outlier.size(); ++i) frame.outlier[i] = false;
+  if (observations.size() < 3) return 0;
+  const PoseOptimizationResult result =
+      OptimizePose(f.intrinsics, *frame.cam_from_world, observations, options_.pose);
+  if (result.num_inliers < 3) return result.num_inliers;  // keep the prediction: too few to trust
+  frame.cam_from_world = result.cam_from_world;
+  for (size_t k = 0; k < indices.size(); ++k) frame.outlier[indices[k]] = result.outlier[k];
+  return result.num_inliers;
+}
+
+int Tracking::DiscardOutliers(Frame& frame) {
+  int in_map = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p) continue;
+    if (frame.outlier[i] || p->bad) {
+      p->last_frame_seen = frame.id;
+      p.reset();
+      frame.outlier[i] = false;
+    } else if (p->NumObservations() > 0) {
+      ++in_map;
+    }
+  }
+  return in_map;
+}
+
+bool Tracking::TrackWithMotionModel(Frame& frame) {
+  const Matcher matcher(0.9f, true);
+  frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
+  const float radius = static_cast<float>(options_.tracking.motion_search_radius);
+  int matches = matcher.SearchByProjection(frame, *last_frame_, radius);
+  if (matches < options_.tracking.min_motion_matches) {
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    matches = matcher.SearchByProjection(frame, *last_frame_, 2 * radius);
+  }
+  if (matches < options_.tracking.min_motion_matches) return false;
+  OptimizeFramePose(frame);
+  return DiscardOutliers(frame) >= 10;
+}
+
+bool Tracking::TrackReferenceKeyFrame(Frame& frame) {
+  if (reference_keyframe_ == nullptr || reference_keyframe_->bad || !last_frame_) return false;
+  const Matcher matcher(0.7f, true);
+  std::vector<std::shared_ptr<MapPoint>> matches;
+  const int n = matcher.SearchByDescriptor(*reference_keyframe_, frame, matches);
+  if (n < 15) return false;
+  frame.map_points = matches;
+  frame.cam_from_world = *last_frame_->cam_from_world;
+  OptimizeFramePose(frame);
+  return DiscardOutliers(frame) >= 10;
+}
+
+void Tracking::UpdateLocalMap(Frame& frame) {
+  // Keyframes that see the frame's points, weighted by how many; the best is the reference.
+  std::map<KeyFrame*, int, KeyFrameIdLess> counter;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad) continue;
+    for (const auto& [kf, idx] : p->observations) ++counter[kf];
+  }
+  local_keyframes_.clear();
+  if (counter.empty()) return;
+  KeyFrame* best = nullptr;
+  int best_count = 0;
+  for (const auto& [kf, count] : counter) {
+    if (kf->bad) continue;
+    if (count > best_count) {
+      best_count = count;
+      best = kf;
+    }
+    kf->local_map_frame = frame.id;
+    local_keyframes_.push_back(kf);
+  }
+  const size_t max_kfs = static_cast<size_t>(options_.tracking.max_local_keyframes);
+  const size_t first_ring = local_keyframes_.size();
+  for (size_t k = 0; k < first_ring && local_keyframes_.size() < max_kfs; ++k) {
+    KeyFrame* kf = local_keyframes_[k];
+    auto add = [&](KeyFrame* other) {
+      if (other == nullptr || other->bad || other->local_map_frame == frame.id) return;
+      other->local_map_frame = frame.id;
+      local_keyframes_.push_back(other);
+    };
+    for (KeyFrame* n : kf->BestCovisibles(10)) add(n);
+    for (KeyFrame* c : kf->children) add(c);
+    add(kf->parent);
+  }
+  if (best != nullptr) {
+    reference_keyframe_ = best;
+    frame.reference_keyframe = best;
+  }
+  // Local points, in keyframe then keypoint order (deterministic).
+  local_points_.clear();
+  for (KeyFrame* kf : local_keyframes_) {
+    for (const auto& p : kf->map_points) {
+      if (!p || p->bad || p->local_map_frame == frame.id) continue;
+      p->local_map_frame = frame.id;
+      local_points_.push_back(p);
+    }
+  }
+}
+
+bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detections, int* culled) {
+  UpdateLocalMap(frame);
+  // Points already matched are not searched again.
+  for (auto& p : frame.map_points) {
+    if (!p) continue;
+    if (p->bad) {
+      p.reset();
+      continue;
+    }
+    ++p->visible;
+    p->last_frame_seen = frame.id;
+  }
+  std::vector<std::shared_ptr<MapPoint>> candidates;
+  std::vector<ProjectionPrediction> predictions;
+  std::vector<std::shared_ptr<MapPoint>> in_view;
+  for (const auto& p : local_points_) {
+    if (p->last_frame_seen == frame.id || p->bad) continue;
+    ProjectionPrediction prediction;
+    if (!frame.InFrustum(*p, 0.5f, &prediction)) continue;
+    ++p->visible;
+    candidates.push_back(p);
+    predictions.push_back(prediction);
+  }
+  // Map points that keep projecting into boxes of dynamic objects are probably on them.
+  if (options_.filter.enable_dynamic_removal && !detections.empty()) {
+    const auto& classes = options_.filter.dynamic_class_ids;
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      for (const Detection& d : detections) {
+        if (!classes.empty() && std::find(classes.begin(), classes.end(), d.class_id) == classes.end()) continue;
+        if (d.box.contains(cv::Point2f(predictions[k].u, predictions[k].v))) {
+          if (++candidates[k]->dynamic_hits >= options_.tracking.dynamic_cull_hits) {
+            map_.ErasePoint(candidates[k].get());
+            ++*culled;
+          }
+          break;
+        }
+      }
+    }
+  }
+  const bool recently_relocalised = frame.id < last_reloc_frame_id_ + 2;
+  const float radius = static_cast<float>(options_.tracking.local_search_radius) * (recently_relocalised ? 1.7f : 1.f);
+  const Matcher matcher(0.8f, false);
+  matcher.SearchByProjection(frame, candidates, predictions, radius);
+
+  OptimizeFramePose(frame);
+  matches_inliers_ = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || frame.outlier[i]) continue;
+    ++p->found;
+    if (p->NumObservations() > 0) ++matches_inliers_;
+  }
+  const uint64_t reloc_window = static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
+  if (num_relocalisations_ > 0 && frame.id < last_reloc_frame_id_ + reloc_window &&
+      matches_inliers_ < options_.tracking.min_inliers_after_reloc) {
+    return false;
+  }
+  return matches_inliers_ >= options_.tracking.min_inliers;
+}
+
+bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
+  const TrackingOptions& t = options_.tracking;
+  const uint64_t since_reloc = frame.id - last_reloc_frame_id_;
+  if (num_relocalisations_ > 0 && since_reloc < static_cast<uint64_t>(t.max_frames_between_keyframes) &&
+      map_.NumKeyFrames() > static_cast<size_t>(t.max_frames_between_keyframes)) {
+    return false;
+  }
+  if (reference_keyframe_ == nullptr) return true;
+  const int min_obs = map_.NumKeyFrames() <= 2 ? 2 : 3;
+  const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
+  const bool idle = local_mapping_.Idle();
+
+  int tracked_close = 0, untracked_close = 0;
+  const FrameFeatures& f = frame.F();
+  for (size_t i = 0; i < f.Size(); ++i) {
+    if (!f.IsClose(i)) continue;
+    if (frame.map_points[i] && !frame.outlier[i]) {
+      ++tracked_close;
+    } else {
+      ++untracked_close;
+    }
+  }
+  const bool need_close = tracked_close < t.close_tracked_min && untracked_close > t.close_untracked_min;
+  const double ratio = map_.NumKeyFrames() < 2 ? 0.4 : t.keyframe_ref_ratio;
+  const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
+  const bool c1a = since_kf >= static_cast<uint64_t>(t.max_frames_between_keyframes);
+  const bool c1b = since_kf >= static_cast<uint64_t>(t.min_frames_between_keyframes) && idle;
+  const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
+  const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
+  return idle || local_mapping_.QueueSize() < 3;
+}
+
+std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
+  std::shared_ptr<KeyFrame> kf = map_.CreateKeyFrame(frame);
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    if (frame.map_points[i] && !frame.outlier[i] && !frame.map_points[i]->bad) {
+      kf->map_points[i] = frame.map_points[i];
+    }
+  }
+  // New points from depth: all close ones, and at least the nearest `new_keyframe_min_points`.
+  const FrameFeatures& f = frame.F();
+  std::vector<std::pair<float, size_t>> by_depth;
+  for (size_t i = 0; i < f.Size(); ++i) {
+    if (f.depth[i] > 0) by_depth.emplace_back(f.depth[i], i);
+  }
+  std::sort(by_depth.begin(), by_depth.end());
+  const Rigid3d world_from_cam = frame.cam_from_world->inverse();
+  int considered = 0;
+  for (const auto& [z, i] : by_depth) {
+    if (!kf->map_points[i]) {
+      auto point = map_.CreateMapPoint(world_from_cam * f.UnprojectCamera(i), kf.get(), frame.id);
+      point->AddObservation(kf.get(), i);
+      kf->AddMapPoint(point, i);
+      point->ComputeDistinctiveDescriptor();
+      point->UpdateNormalAndDepth();
+      frame.map_points[i] = point;
+      frame.outlier[i] = false;
+    }
+    ++considered;
+    if (z > f.close_depth && considered > options_.tracking.new_keyframe_min_points) break;
+  }
+  reference_keyframe_ = kf.get();
+  frame.reference_keyframe = kf.get();
+  last_keyframe_frame_id_ = frame.id;
+  return kf;
+}
+
+bool Tracking::Relocalise(Frame& frame) {
+  std::vector<KeyFrame*> candidates;
+  for (auto it = map_.KeyFrames().rbegin(); it != map_.KeyFrames().rend(); ++it) {
+    if (static_cast<int>(candidates.size()) >= options_.tracking.relocalisation_keyframes) break;
+    if (!it->second->bad) candidates.push_back(it->second.get());
+  }
+  const FrameFeatures& f = frame.F();
+  const Matcher matcher(0.75f, true);
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << f.intrinsics.fx, 0, f.intrinsics.cx, 0,
+                     f.intrinsics.fy, f.intrinsics.cy, 0, 0, 1);
+  for (KeyFrame* kf : candidates) {
+    std::vector<std::shared_ptr<MapPoint>> matches;
+    if (matcher.SearchByDescriptor(*kf, frame, matches) < 15) continue;
+    std::vector<cv::Point3f> object;
+    std::vector<cv::Point2f> image;
+    std::vector<size_t> indices;
+    for (size_t i = 0; i < matches.size(); ++i) {
+      if (!matches[i]) continue;
+      const Eigen::Vector3d& x = matches[i]->position;
+      object.emplace_back(static_cast<float>(x.x()), static_cast<float>(x.y()), static_cast<float>(x.z()));
+      image.push_back(f.keypoints_un[i].pt);
+      indices.push_back(i);
+    }
+    cv::Mat rvec, tvec;
+    std::vector<int> inliers;
+    if (!cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, false, 200, 3.0f, 0.99,
+                            inliers, cv::SOLVEPNP_EPNP) ||
+        inliers.size() < 10) {
+      continue;
+    }
+    cv::Mat R;
+    cv::Rodrigues(rvec, R);
+    Eigen::Matrix3d rotation;
+    cv::cv2eigen(R, rotation);
+    Rigid3d pose = Rigid3d::Identity();
+    pose.linear() = rotation;
+    pose.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    frame.cam_from_world = pose;
+    std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+    for (int k : inliers) frame.map_points[indices[k]] = matches[indices[k]];
+
+    int good = OptimizeFramePose(frame);
+    if (good < 10) continue;
+    DiscardOutliers(frame);
+    const int min_good = options_.tracking.min_inliers_after_reloc;
+    if (good < min_good) {
+      const int additional = matcher.SearchByProjection(frame, *kf, 10.f, 100);
+      if (additional + good >= min_good) {
+        good = OptimizeFramePose(frame);
+        DiscardOutliers(frame);
+      }
+    }
+    if (good >= min_good) {
+      last_reloc_frame_id_ = frame.id;
+      reference_keyframe_ = kf;
+      frame.reference_keyframe = kf;
+      return true;
+    }
+  }
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  frame.cam_from_world.reset();
+  return false;
+}
+
+}  // namespace ademono

@@ -1,0 +1,92 @@
+#pragma once
+// Tracking for RGB-D input (ORB-SLAM2's Tracking with per-frame depth, no monocular
+// initialisation): map initialisation from the first frame with enough depth, constant-velocity
+// tracking by projection (window widened once), reference-keyframe tracking by descriptor
+// matching as fallback, local-map tracking, the keyframe decision, relocalisation (PnP RANSAC
+// against recent keyframes) and a restart from the last pose after a long loss.
+// Every call runs with the map mutex held by the caller.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "ademono/detect/detection.h"
+#include "ademono/slam/frame.h"
+#include "ademono/slam/local_mapping.h"
+#include "ademono/slam/map.h"
+#include "ademono/slam/options.h"
+
+namespace ademono {
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+
+// What the trajectory needs of each input frame: its pose relative to a keyframe, so that later
+// keyframe corrections (local BA, culling) move it along.
+struct FrameRecord {
+  size_t index = 0;
+  double timestamp = 0;
+  bool tracked = false;
+  KeyFrame* reference = nullptr;  // owned by the map (never freed while the map lives)
+  Rigid3d cam_from_reference = Rigid3d::Identity();
+};
+
+struct TrackingOutput {
+  bool tracked = false;
+  Rigid3d cam_from_world = Rigid3d::Identity();
+  std::shared_ptr<KeyFrame> new_keyframe;  // to hand to local mapping (outside the lock)
+  int inliers = 0;
+  bool relocalised = false;
+  bool reinitialised = false;
+  int dynamic_points_culled = 0;
+};
+
+class Tracking {
+ public:
+  Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options);
+
+  TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index, double timestamp,
+                       const std::vector<Detection>& detections);
+
+  TrackingState State() const { return state_; }
+  const std::vector<FrameRecord>& Records() const { return records_; }
+  // Constant-velocity prediction of the next frame's pose (if tracking is OK).
+  std::optional<Rigid3d> PredictNext() const;
+  const std::optional<Frame>& LastFrame() const { return last_frame_; }
+  int NumLost() const { return num_lost_; }
+  int NumRelocalisations() const { return num_relocalisations_; }
+
+ private:
+  bool Initialise(Frame& frame, const Rigid3d& cam_from_world);
+  bool TrackWithMotionModel(Frame& frame);
+  bool TrackReferenceKeyFrame(Frame& frame);
+  bool TrackLocalMap(Frame& frame, const std::vector<Detection>& detections, int* culled);
+  bool Relocalise(Frame& frame);
+  bool NeedNewKeyFrame(const Frame& frame) const;
+  std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame);
+  int OptimizeFramePose(Frame& frame);
+  int DiscardOutliers(Frame& frame);
+  void UpdateLocalMap(Frame& frame);
+  int CountDepthPoints(const Frame& frame) const;
+
+  Map& map_;
+  const LocalMapping& local_mapping_;
+  SystemOptions options_;
+  TrackingState state_ = TrackingState::kNotInitialized;
+  uint64_t next_frame_id_ = 0;
+  std::optional<Frame> last_frame_;
+  std::optional<Rigid3d> velocity_;        // current_from_last
+  std::optional<Rigid3d> last_good_pose_;  // cam_from_world of the last tracked frame
+  KeyFrame* reference_keyframe_ = nullptr;
+  uint64_t last_keyframe_frame_id_ = 0;
+  uint64_t last_reloc_frame_id_ = 0;
+  int matches_inliers_ = 0;
+  int lost_streak_ = 0;
+  int num_lost_ = 0;
+  int num_relocalisations_ = 0;
+  std::vector<KeyFrame*> local_keyframes_;
+  std::vector<std::shared_ptr<MapPoint>> local_points_;
+  std::vector<FrameRecord> records_;
+};
+
+}  // namespace ademono
