@@ -149,17 +149,17 @@ void WriteDetectionsJsonl(const std::filesystem::path& path,
   }
   WriteFileAtomic(path, [&](std::ostream& out) {
     for (const FrameDetections& frame : frames) {
-      json detections = json::array();
-      for (const Detection& detection : frame.detections) {
-        detections.push_back(
-            json{{"class_id", detection.class_id},
-                 {"class", detection.class_name},
-                 {"score", FloatForJson(detection.score)},
-                 {"box_xywh",
-                  {FloatForJson(detection.box.x), FloatForJson(detection.box.y),
-                   FloatForJson(detection.box.width), FloatForJson(detection.box.height)}}});
-      }
       // ordered_json keeps the documented key order, which makes the file easy to read.
+      nlohmann::ordered_json detections = nlohmann::ordered_json::array();
+      for (const Detection& detection : frame.detections) {
+        nlohmann::ordered_json item;
+        item["class_id"] = detection.class_id;
+        item["class"] = detection.class_name;
+        item["score"] = FloatForJson(detection.score);
+        item["box_xywh"] = {FloatForJson(detection.box.x), FloatForJson(detection.box.y),
+                            FloatForJson(detection.box.width), FloatForJson(detection.box.height)};
+        detections.push_back(std::move(item));
+      }
       nlohmann::ordered_json object;
       object["frame"] = frame.frame;
       object["timestamp"] = frame.timestamp;
