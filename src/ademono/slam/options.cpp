@@ -24,7 +24,7 @@ void Require(bool ok, const std::string& message) {
 
 void CheckKnownKeys(const YAML::Node& node, const char* section,
                     std::initializer_list<const char*> keys) {
-  if (!node) return;
+  if (!node || node.IsNull()) return;
   if (!node.IsMap()) throw std::invalid_argument(std::string("'") + section + "' must be a map");
   for (const auto& entry : node) {
     const std::string key = entry.first.as<std::string>();
@@ -149,7 +149,7 @@ SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesys
     if (root && !root.IsNull() && !root.IsMap()) throw std::invalid_argument("root must be a map");
     CheckKnownKeys(root, "(root)",
                    {"camera", "orb", "filter", "depth", "tracking", "mapping", "optimizer",
-                    "run", "dataset", "detector"});
+                    "detector"});
     if (root["orb"]) o.orb = OrbOptions::FromYaml(root["orb"]);
     if (root["filter"]) o.filter = FilterOptions::FromYaml(root["filter"]);
     o.depth = FrameDepthOptions::FromYaml(root["depth"]);

@@ -1,0 +1,328 @@
+// `ademono run`: SLAM over a dataset sequence. Writes trajectory.tum, trajectory.kitti,
+// keyframes.tum, map.ply and summary.json into --out (each atomically), optionally per-frame
+// feature images into --viz.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include "ademono/core/error.h"
+#include "ademono/core/file_util.h"
+#include "ademono/depth/depth_factory.h"
+#include "ademono/detect/detector_factory.h"
+#include "ademono/io/sequence.h"
+#include "ademono/io/trajectory.h"
+#include "ademono/slam/pipeline.h"
+#include "ademono/slam/system.h"
+#include "command.h"
+
+#if __has_include("ademono/eval/ate.h")
+#include "ademono/eval/ate.h"
+#define ADEMONO_HAVE_EVAL_ATE 1
+#endif
+
+namespace fs = std::filesystem;
+
+namespace ademono::cli {
+namespace {
+
+struct RunArgs {
+  std::string dataset;
+  std::string config;
+  std::string depth = "sensor";
+  std::string detector = "none";
+  std::string frames;
+  std::string seed = "42";
+  bool no_enhancement = false;
+  bool no_dynamic_removal = false;
+  bool no_distant_filter = false;
+  bool threaded = false;
+  bool no_overlap = false;
+  std::string viz;
+  std::string camera;
+  std::string out;
+};
+
+// Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
+// binary was built from (bin/ is build/<name>/bin).
+fs::path FindConfigDir() {
+  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0') return env;
+  if (fs::is_directory("configs")) return "configs";
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
+      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt")) return dir / "configs";
+    }
+  }
+  return {};
+}
+
+// The family config for a dataset: tum_fr1/2/3 by the "freiburgN" / "frN" in the path, kitti by
+// sequence number (00-02, 03, 04-12), else <kind>.yaml.
+std::string DefaultConfigName(const std::string& kind, const std::string& path) {
+  if (kind == "tum") {
+    std::smatch m;
+    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])"))) return "tum_fr" + m[2].str() + ".yaml";
+    return "tum_fr1.yaml";
+  }
+  if (kind == "kitti") {
+    std::smatch m;
+    int sequence = 0;
+    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)"))) sequence = std::stoi(m[1].str());
+    if (sequence <= 2) return "kitti_00-02.yaml";
+    if (sequence == 3) return "kitti_03.yaml";
+    return "kitti_04-12.yaml";
+  }
+  if (kind == "7scenes") return "7scenes.yaml";
+  if (kind == "euroc") return "euroc.yaml";
+  return kind + ".yaml";
+}
+
+YAML::Node LoadConfig(const fs::path& path) {
+  RequireFile(path);
+  try {
+    return YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(path, std::string("invalid YAML: ") + e.msg);
+  }
+}
+
+void ParseFrames(const std::string& text, size_t* start, size_t* end) {
+  static const std::regex pattern("^(\\d*):(\\d*)$");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern)) {
+    throw InputError("--frames '" + text + "': expected START:END (either may be empty)");
+  }
+  if (!m[1].str().empty()) *start = std::stoull(m[1].str());
+  if (!m[2].str().empty()) *end = std::stoull(m[2].str());
+  if (*end <= *start) throw InputError("--frames '" + text + "': END must be greater than START");
+}
+
+uint64_t ParseSeed(const std::string& text) {
+  if (text == "time") {
+    return static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+  }
+  try {
+    size_t used = 0;
+    const uint64_t seed = std::stoull(text, &used);
+    if (used == text.size()) return seed;
+  } catch (const std::exception&) {
+  }
+  throw InputError("--seed '" + text + "': expected a non-negative integer or 'time'");
+}
+
+void WritePly(const fs::path& path, const std::vector<System::ColoredPoint>& cloud) {
+  WriteFileAtomic(path, [&](std::ostream& os) {
+    os << "ply\nformat ascii 1.0\nelement vertex " << cloud.size()
+       << "\nproperty float x\nproperty float y\nproperty float z\n"
+          "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+    char line[128];
+    for (const auto& p : cloud) {
+      std::snprintf(line, sizeof(line), "%.6f %.6f %.6f %d %d %d\n", p.position.x(), p.position.y(),
+                    p.position.z(), p.bgr[2], p.bgr[1], p.bgr[0]);
+      os << line;
+    }
+  });
+}
+
+void WriteViz(const fs::path& dir, const FrameData& frame, const TrackResult& r) {
+  cv::Mat canvas;
+  if (frame.image.channels() == 1) {
+    cv::cvtColor(frame.image, canvas, cv::COLOR_GRAY2BGR);
+  } else {
+    canvas = frame.image.clone();
+  }
+  for (size_t i = 0; i < r.keypoints.size() && i < r.labels.size(); ++i) {
+    cv::Scalar color;
+    switch (r.labels[i]) {
+      case PointLabel::kKept: color = {0, 255, 0}; break;
+      case PointLabel::kEnhancementDropped: color = {160, 160, 160}; break;
+      case PointLabel::kDynamicSmallBox:
+      case PointLabel::kDynamicStage1:
+      case PointLabel::kDynamicStage2: color = {0, 0, 255}; break;
+      case PointLabel::kDistantDropped: color = {255, 0, 0}; break;
+    }
+    cv::circle(canvas, r.keypoints[i].pt, 3, color, 1, cv::LINE_AA);
+  }
+  std::ostringstream name;
+  name << "frame-" << std::setw(6) << std::setfill('0') << frame.index << ".jpg";
+  WriteImageAtomic(dir / name.str(), canvas);
+}
+
+nlohmann::json TimingJson(const std::vector<double>& values) {
+  return {{"median_ms", Percentile(values, 0.5)}, {"p95_ms", Percentile(values, 0.95)}};
+}
+
+int Run(const RunArgs& args) {
+  if (args.out.empty()) throw InputError("--out is required");
+  std::optional<fs::path> camera_yaml;
+  if (!args.camera.empty()) camera_yaml = args.camera;
+  const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
+
+  // Config: --config or the dataset family's default.
+  fs::path config_path = args.config;
+  if (config_path.empty()) {
+    const fs::path dir = FindConfigDir();
+    const fs::path candidate = dir / DefaultConfigName(sequence->Kind(), sequence->Path().string());
+    if (!dir.empty() && fs::exists(candidate)) {
+      config_path = candidate;
+    } else {
+      spdlog::warn("no config for '{}' found ({}); using built-in defaults", sequence->Kind(),
+                   candidate.string());
+    }
+  }
+  YAML::Node config = config_path.empty() ? YAML::Node() : LoadConfig(config_path);
+  SystemOptions options = SystemOptions::FromYaml(config, config_path);
+  DetectorOptions detector_options;
+  try {
+    if (const YAML::Node d = config["detector"]) {
+      if (d["score_threshold"]) detector_options.score_threshold = d["score_threshold"].as<float>();
+      if (d["nms_iou"]) detector_options.nms_iou = d["nms_iou"].as<float>();
+    }
+    detector_options.Check();
+  } catch (const std::exception& e) {
+    ThrowInputError(config_path, std::string("detector: ") + e.what());
+  }
+  options.filter.seed = ParseSeed(args.seed);
+  if (args.no_enhancement) options.filter.enable_enhancement = false;
+  if (args.no_dynamic_removal) options.filter.enable_dynamic_removal = false;
+  if (args.no_distant_filter) options.filter.enable_distant_filter = false;
+  if (args.threaded) options.mapping.deterministic = false;
+
+  PipelineOptions pipeline;
+  if (!args.frames.empty()) ParseFrames(args.frames, &pipeline.start, &pipeline.end);
+  if (pipeline.start >= sequence->Size()) {
+    throw InputError("--frames '" + args.frames + "': sequence has only " + std::to_string(sequence->Size()) + " frames");
+  }
+  pipeline.overlap = !args.no_overlap;
+
+  DepthFactoryContext context;
+  context.sequence = sequence.get();
+  context.seed = options.filter.seed;
+  std::unique_ptr<DepthProvider> depth = MakeDepthProvider(args.depth, context);
+  std::unique_ptr<Detector> detector = MakeDetector(args.detector, detector_options);
+
+  const fs::path out(args.out);
+  const fs::path viz = args.viz;
+  System system(sequence->GetCamera(), options);
+  const size_t total = std::min(pipeline.end, sequence->Size()) - pipeline.start;
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  const auto start_time = std::chrono::steady_clock::now();
+  size_t done = 0;
+  int lost_so_far = 0;
+  pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&, const std::vector<Detection>&,
+                          const TrackResult& r) {
+    ++done;
+    if (!r.tracked && r.state != TrackingState::kNotInitialized) ++lost_so_far;
+    if (!viz.empty()) WriteViz(viz, frame, r);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    const double fps = seconds > 0 ? done / seconds : 0.0;
+    if (tty) {
+      const int width = 30;
+      const int filled = static_cast<int>(width * done / std::max<size_t>(1, total));
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.1f fps  lost %d", std::string(filled, '=').c_str(),
+                   std::string(width - filled, ' ').c_str(), done, total, fps, lost_so_far);
+      if (done == total) std::fprintf(stderr, "\n");
+    } else if (done % 100 == 0 || done == total) {
+      std::fprintf(stderr, "ademono run: %zu/%zu frames, %.1f fps, lost %d\n", done, total, fps, lost_so_far);
+    }
+  };
+  const PipelineResult result = RunPipeline(*sequence, depth.get(), detector.get(), system, pipeline);
+  system.Shutdown();
+
+  // Outputs.
+  const Trajectory trajectory = system.FrameTrajectory();
+  const Trajectory keyframes = system.KeyFrameTrajectory();
+  if (trajectory.empty()) {
+    throw InputError(args.dataset + ": no frame could be tracked (the map never initialised: too little valid depth?)");
+  }
+  WriteTumTrajectory(out / "trajectory.tum", trajectory);
+  WriteKittiTrajectory(out / "trajectory.kitti", trajectory);
+  WriteTumTrajectory(out / "keyframes.tum", keyframes);
+  WritePly(out / "map.ply", system.MapPointCloud());
+
+  std::vector<double> extraction, depth_ms, detection, filter, tracking, mapping;
+  for (const FrameTiming& t : result.timings) {
+    extraction.push_back(t.extraction_ms);
+    depth_ms.push_back(t.depth_ms);
+    detection.push_back(t.detection_ms);
+    filter.push_back(t.filter_ms);
+    tracking.push_back(t.tracking_ms);
+    mapping.push_back(t.mapping_ms);
+  }
+  nlohmann::json summary;
+  summary["dataset"] = args.dataset;
+  summary["config"] = config_path.string();
+  summary["depth"] = depth->Name();
+  summary["detector"] = detector->Name();
+  summary["seed"] = options.filter.seed;
+  summary["deterministic"] = options.mapping.deterministic;
+  summary["filters"] = {{"enhancement", options.filter.enable_enhancement},
+                        {"dynamic_removal", options.filter.enable_dynamic_removal},
+                        {"distant", options.filter.enable_distant_filter}};
+  summary["frames"] = result.frames;
+  summary["tracked"] = trajectory.size();
+  summary["untracked"] = result.frames - trajectory.size();
+  summary["lost"] = system.NumLost();
+  summary["keyframes"] = system.NumKeyFrames();
+  summary["map_points"] = system.NumMapPoints();
+  summary["wall_seconds"] = result.wall_seconds;
+  summary["fps"] = result.wall_seconds > 0 ? result.frames / result.wall_seconds : 0.0;
+  summary["timing"] = {{"extraction", TimingJson(extraction)}, {"depth", TimingJson(depth_ms)},
+                       {"detection", TimingJson(detection)},   {"filter", TimingJson(filter)},
+                       {"tracking", TimingJson(tracking)},     {"local_mapping", TimingJson(mapping)}};
+#ifdef ADEMONO_HAVE_EVAL_ATE
+  if (sequence->HasGroundTruth()) summary["ate"] = AteSummaryJson(trajectory, result.ground_truth_frames);
+#endif
+  WriteTextFileAtomic(out / "summary.json", summary.dump(2) + "\n");
+
+  std::cout << "tracked " << trajectory.size() << "/" << result.frames << " frames (lost " << system.NumLost()
+            << "), " << system.NumKeyFrames() << " keyframes, " << system.NumMapPoints()
+            << " map points; tracking median " << std::fixed << std::setprecision(1)
+            << Percentile(tracking, 0.5) << " ms/frame\n";
+  if (trajectory.size() < result.frames) {
+    std::cout << (result.frames - trajectory.size()) << " frames untracked (no pose written)\n";
+  }
+  return 0;
+}
+
+const bool kRegistered = RegisterCommand(
+    "run", "Run SLAM over a dataset sequence and write trajectory, keyframes, map and summary",
+    [](CLI::App& app) -> Runner {
+      auto args = std::make_shared<RunArgs>();
+      app.add_option("--dataset", args->dataset, "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")->required();
+      app.add_option("--config", args->config, "config YAML (default: configs/<family>.yaml)");
+      app.add_option("--depth", args->depth, "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
+          ->capture_default_str();
+      app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
+          ->capture_default_str();
+      app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
+      app.add_option("--seed", args->seed, "random seed of the distant filter: N or 'time'")->capture_default_str();
+      app.add_flag("--no-enhancement", args->no_enhancement, "disable depth-weighted feature enhancement");
+      app.add_flag("--no-dynamic-removal", args->no_dynamic_removal, "disable dynamic interference removal");
+      app.add_flag("--no-distant-filter", args->no_distant_filter, "disable distant-point filtering");
+      app.add_flag("--threaded", args->threaded,
+                   "local mapping in its own thread (faster wall time, not reproducible run to run)");
+      app.add_flag("--no-overlap", args->no_overlap, "compute depth/detections sequentially (no prefetch)");
+      app.add_option("--viz", args->viz, "write per-frame images with filter labels into DIR");
+      app.add_option("--camera", args->camera, "camera YAML (overrides the dataset's)");
+      app.add_option("--out", args->out, "output directory")->required();
+      return [args] { return Run(*args); };
+    });
+
+}  // namespace
+}  // namespace ademono::cli

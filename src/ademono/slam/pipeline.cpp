@@ -1,0 +1,89 @@
+#include "ademono/slam/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <future>
+
+namespace ademono {
+namespace {
+
+struct Prepared {
+  FrameData frame;
+  cv::Mat depth;
+  std::vector<Detection> detections;
+  double depth_ms = 0, detection_ms = 0;
+};
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {
+  Prepared p;
+  p.frame = sequence.Load(i);
+  auto start = std::chrono::steady_clock::now();
+  if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
+  p.depth_ms = MsSince(start);
+  start = std::chrono::steady_clock::now();
+  if (detector != nullptr) p.detections = detector->Detect(p.frame);
+  p.detection_ms = MsSince(start);
+  return p;
+}
+
+}  // namespace
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double pos = q * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(values.size() - 1, lo + 1);
+  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
+PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detector* detector,
+                           System& system, const PipelineOptions& options) {
+  PipelineResult result;
+  const size_t end = std::min(options.end, sequence.Size());
+  const auto wall_start = std::chrono::steady_clock::now();
+  std::future<Prepared> next;
+  for (size_t i = options.start; i < end; ++i) {
+    Prepared current;
+    if (options.overlap && next.valid()) {
+      current = next.get();  // rethrows a provider's InputError here, in frame order
+    } else {
+      current = Prepare(sequence, depth, detector, i);
+    }
+    if (options.overlap && i + 1 < end) {
+      next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector, i + 1);
+    }
+    TrackResult r;
+    try {
+      r = system.TrackFrame(current.frame, current.depth, current.detections);
+    } catch (...) {
+      if (next.valid()) next.wait();  // never leave the worker running on a dying pipeline
+      throw;
+    }
+    FrameTiming t;
+    t.extraction_ms = r.extraction_ms;
+    t.depth_ms = current.depth_ms;
+    t.detection_ms = current.detection_ms;
+    t.filter_ms = r.filter_ms;
+    t.tracking_ms = r.tracking_ms;
+    t.mapping_ms = r.mapping_ms;
+    result.timings.push_back(t);
+    if (options.on_frame) options.on_frame(current.frame, current.depth, current.detections, r);
+    FrameData gt;
+    gt.index = current.frame.index;
+    gt.timestamp = current.frame.timestamp;
+    gt.name = current.frame.name;
+    gt.world_from_cam_gt = current.frame.world_from_cam_gt;
+    result.ground_truth_frames.push_back(std::move(gt));
+    ++result.frames;
+  }
+  result.wall_seconds = MsSince(wall_start) / 1000.0;
+  return result;
+}
+
+}  // namespace ademono

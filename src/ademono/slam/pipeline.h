@@ -1,0 +1,49 @@
+#pragma once
+// The per-frame loop of `ademono run`: load frame, compute its depth and detections, track it.
+// With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
+// while frame k is tracked (a one-frame prefetch); results are identical to the sequential loop
+// because providers are deterministic and tracking still sees frames in order.
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "ademono/depth/depth_provider.h"
+#include "ademono/detect/detection.h"
+#include "ademono/io/sequence.h"
+#include "ademono/slam/system.h"
+
+namespace ademono {
+
+struct PipelineOptions {
+  size_t start = 0;               // first frame (inclusive)
+  size_t end = SIZE_MAX;          // last frame (exclusive), clamped to the sequence size
+  bool overlap = true;            // prefetch depth/detections of the next frame
+  // Called after each frame (in order, on the calling thread).
+  std::function<void(const FrameData&, const cv::Mat& depth, const std::vector<Detection>&,
+                     const TrackResult&)>
+      on_frame;
+};
+
+struct FrameTiming {
+  double extraction_ms = 0, depth_ms = 0, detection_ms = 0, filter_ms = 0, tracking_ms = 0,
+         mapping_ms = 0;
+};
+
+struct PipelineResult {
+  std::vector<FrameTiming> timings;           // one per processed frame
+  std::vector<FrameData> ground_truth_frames; // index, timestamp and gt pose (images dropped)
+  size_t frames = 0;
+  double wall_seconds = 0;
+};
+
+// Throws InputError from the sequence or the providers (e.g. a missing cached depth map).
+// `depth` may be null (no depth: 2-dof tracking only, needs an initialised map from elsewhere,
+// so in practice always given); `detector` may be null (no detections).
+PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detector* detector,
+                           System& system, const PipelineOptions& options);
+
+// Median and 95th percentile of a list of values (0 for an empty list).
+double Percentile(std::vector<double> values, double q);
+
+}  // namespace ademono
