@@ -1,0 +1,234 @@
+#include "ademono/filter/dynamic.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace ademono {
+namespace {
+
+Camera TestCamera() {
+  Camera c;
+  c.width = 640;
+  c.height = 480;
+  c.fx = c.fy = 500;
+  c.cx = 320;
+  c.cy = 240;
+  return c;
+}
+
+Detection Det(int class_id, float x, float y, float w, float h) {
+  Detection d;
+  d.class_id = class_id;
+  d.class_name = class_id == 0 ? "person" : "vehicle";
+  d.score = 0.9f;
+  d.box = cv::Rect2f(x, y, w, h);
+  return d;
+}
+
+cv::KeyPoint Kp(float x, float y) { return cv::KeyPoint(x, y, 31.f); }
+
+// Random, well separated 32-byte descriptors (pairwise distances around 128).
+cv::Mat RandomDescriptors(int rows, uint32_t seed) {
+  std::mt19937 rng(seed);
+  cv::Mat d(rows, 32, CV_8UC1);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < 32; ++c) d.at<uchar>(r, c) = static_cast<uchar>(rng() & 0xFF);
+  return d;
+}
+
+void FlipBits(cv::Mat& descriptors, int row, int bits) {
+  for (int b = 0; b < bits; ++b)
+    descriptors.at<uchar>(row, b / 8) ^= static_cast<uchar>(1 << (b % 8));
+}
+
+TEST(GrowDynamicBoxesTest, GrowthClippingSizeClassAndClassFilter) {
+  const std::vector<Detection> dets{
+      Det(0, 100, 100, 30, 40),    // person, area 1200 / 307200 = 0.4% -> small; diag 50 -> d = 1
+      Det(2, 300, 200, 200, 200),  // car, 13% -> large
+      Det(56, 10, 10, 300, 300),   // chair: not a dynamic class
+      Det(7, 600, 400, 100, 100),  // truck reaching past the image corner: clipped
+  };
+  const std::vector<GrownBox> boxes = GrowDynamicBoxes(dets, cv::Size(640, 480), DynamicParams{});
+  ASSERT_EQ(boxes.size(), 3u);
+  EXPECT_TRUE(boxes[0].small);
+  EXPECT_EQ(boxes[0].detection_index, 0);
+  EXPECT_FLOAT_EQ(boxes[0].box.x, 99.f);
+  EXPECT_FLOAT_EQ(boxes[0].box.y, 99.f);
+  EXPECT_FLOAT_EQ(boxes[0].box.width, 32.f);
+  EXPECT_FLOAT_EQ(boxes[0].box.height, 42.f);
+  EXPECT_FALSE(boxes[1].small);
+  EXPECT_EQ(boxes[2].detection_index, 3);
+  EXPECT_TRUE(boxes[2].small);  // 10000 / 307200 = 3.3% < 5%
+  const double d = 0.02 * std::hypot(100.0, 100.0);
+  EXPECT_NEAR(boxes[2].box.x, 600 - d, 1e-4);
+  EXPECT_FLOAT_EQ(boxes[2].box.x + boxes[2].box.width, 640.f);
+  EXPECT_FLOAT_EQ(boxes[2].box.y + boxes[2].box.height, 480.f);
+  EXPECT_TRUE(InsideBox(cv::Rect2f(0, 0, 10, 10), cv::Point2f(0, 9.99f)));
+  EXPECT_FALSE(InsideBox(cv::Rect2f(0, 0, 10, 10), cv::Point2f(10, 5)));
+}
+
+// A scene with one small and one large dynamic box, background points moving by (2, 1) between
+// frames, and large-box points exercising each branch of the two-stage test.
+struct Scene {
+  Camera camera = TestCamera();
+  std::vector<Detection> detections{Det(0, 100, 100, 30, 40), Det(2, 300, 200, 200, 200)};
+  std::vector<cv::KeyPoint> cur, prev;
+  cv::Mat cur_desc, prev_desc;
+  PreviousFrameFeatures previous;
+  Rigid3d predicted = Rigid3d::Identity();
+
+  // Indices of the current keypoints.
+  enum : int {
+    kSmallInside = 0,  // in the grown small box, outside the original box
+    kSmallOutside,     // just outside the grown small box: background
+    kBg1,
+    kBg2,
+    kBg3,             // background, exact descriptor matches, moving (2, 1)
+    kBgOutlier,       // background moving (40, 0) but with a worse descriptor match (t = 3)
+    kLargeStatic,     // in the large box, moves like the background, projects exactly
+    kLargeStage1,     // in the large box, moves (20, 1)
+    kLargeStage2,     // moves like the background, world point projects 10 px away
+    kLargeNoWorld,    // moves like the background, no world point
+    kLargeUnmatched,  // descriptor matches nothing in the previous frame
+    kLargeNearProj,   // projects 3 px away (< d_min 4)
+    kLargeBehind,     // world point behind the predicted camera
+    kCount
+  };
+
+  Scene() {
+    const cv::Point2f bg(2, 1);
+    const std::vector<cv::Point2f> cur_pts{
+        {99.5f, 99.5f}, {98.5f, 120}, {20, 20},   {600, 30},  {50, 400},  {200, 50}, {350, 250},
+        {400, 300},     {450, 350},   {320, 380}, {480, 220}, {360, 300}, {420, 240}};
+    const std::vector<cv::Point2f> motion{bg,      bg, bg, bg, bg, {40, 0}, bg,
+                                          {20, 1}, bg, bg, bg, bg, bg};
+    cur_desc = RandomDescriptors(kCount, 7);
+    prev_desc = cur_desc.clone();
+    FlipBits(prev_desc, kBgOutlier, 12);  // still matched, but the worst background match
+    FlipBits(prev_desc, kBg3, 3);         // distance 3: among the three best
+    prev_desc.row(kLargeUnmatched).setTo(0);
+    cur_desc.row(kLargeUnmatched).setTo(0xFF);  // 256 bits from its old self
+    for (int i = 0; i < kCount; ++i) {
+      cur.push_back(Kp(cur_pts[i].x, cur_pts[i].y));
+      prev.push_back(Kp(cur_pts[i].x - motion[i].x, cur_pts[i].y - motion[i].y));
+    }
+    previous.keypoints = prev;
+    previous.descriptors = prev_desc;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    previous.points_world.assign(kCount, Eigen::Vector3d(nan, nan, nan));
+    auto world_at = [&](float u, float v) { return camera.Unproject(Eigen::Vector2d(u, v), 2.0); };
+    previous.points_world[kLargeStatic] = world_at(350, 250);
+    previous.points_world[kLargeStage2] = world_at(460, 350);  // 10 px right of the observation
+    previous.points_world[kLargeNearProj] = world_at(363, 300);
+    previous.points_world[kLargeBehind] = Eigen::Vector3d(0, 0, -2);
+    // kLargeStage1 would project exactly: stage 1 alone must catch it.
+    previous.points_world[kLargeStage1] = world_at(400, 300);
+  }
+
+  DynamicInput Input() const {
+    DynamicInput in;
+    in.keypoints = &cur;
+    in.descriptors = &cur_desc;
+    in.detections = &detections;
+    in.previous = &previous;
+    in.camera = &camera;
+    in.predicted_cam_from_world = predicted;
+    return in;
+  }
+};
+
+DynamicParams Params() {
+  DynamicParams p;
+  p.background_matches_t = 3;
+  return p;
+}
+
+TEST(RemoveDynamicPointsTest, EveryBranchGetsItsLabel) {
+  const Scene s;
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), Params());
+  ASSERT_EQ(r.labels.size(), static_cast<size_t>(Scene::kCount));
+  ASSERT_EQ(r.boxes.size(), 2u);
+  ASSERT_TRUE(r.background_motion.has_value());
+  EXPECT_EQ(r.num_background_matches, 3);
+  // Mean of the three best background matches: kSmallOutside, kBg1, kBg2 (distance 0).
+  EXPECT_NEAR(r.background_motion->x(), 2.0, 1e-9);
+  EXPECT_NEAR(r.background_motion->y(), 1.0, 1e-9);
+  const std::vector<PointLabel> expected{PointLabel::kDynamicSmallBox,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kDynamicStage1,
+                                         PointLabel::kDynamicStage2,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kKept,
+                                         PointLabel::kDynamicStage2};
+  for (int i = 0; i < Scene::kCount; ++i)
+    EXPECT_EQ(r.labels[i], expected[i]) << "point " << i << ": " << PointLabelName(r.labels[i]);
+}
+
+TEST(RemoveDynamicPointsTest, LargerTIncludesTheOutlierInTheBackgroundMotion) {
+  const Scene s;
+  DynamicParams p = Params();
+  p.background_matches_t = 20;  // all 5 background matches: mean (2 * 4 + 40) / 5 = 9.6, 0.8
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), p);
+  ASSERT_TRUE(r.background_motion.has_value());
+  EXPECT_EQ(r.num_background_matches, 5);
+  EXPECT_NEAR(r.background_motion->x(), 9.6, 1e-6);
+  EXPECT_NEAR(r.background_motion->y(), 0.8, 1e-6);
+}
+
+TEST(RemoveDynamicPointsTest, WithoutPreviousFrameOnlySmallBoxesRemove) {
+  const Scene s;
+  DynamicInput in = s.Input();
+  in.previous = nullptr;
+  const DynamicResult r = RemoveDynamicPoints(in, Params());
+  for (int i = 0; i < Scene::kCount; ++i)
+    EXPECT_EQ(r.labels[i],
+              i == Scene::kSmallInside ? PointLabel::kDynamicSmallBox : PointLabel::kKept);
+  EXPECT_FALSE(r.background_motion.has_value());
+}
+
+TEST(RemoveDynamicPointsTest, WithoutPredictionOnlyStageOneRuns) {
+  const Scene s;
+  DynamicInput in = s.Input();
+  in.predicted_cam_from_world.reset();
+  const DynamicResult r = RemoveDynamicPoints(in, Params());
+  EXPECT_EQ(r.labels[Scene::kLargeStage1], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[Scene::kLargeStage2], PointLabel::kKept);
+  EXPECT_EQ(r.labels[Scene::kLargeBehind], PointLabel::kKept);
+}
+
+TEST(RemoveDynamicPointsTest, InactivePointsAreLeftAlone) {
+  const Scene s;
+  DynamicInput in = s.Input();
+  in.active.assign(Scene::kCount, true);
+  in.active[Scene::kSmallInside] = false;
+  in.active[Scene::kLargeStage1] = false;
+  const DynamicResult r = RemoveDynamicPoints(in, Params());
+  EXPECT_EQ(r.labels[Scene::kSmallInside], PointLabel::kKept);
+  EXPECT_EQ(r.labels[Scene::kLargeStage1], PointLabel::kKept);
+  EXPECT_EQ(r.labels[Scene::kLargeStage2], PointLabel::kDynamicStage2);
+}
+
+TEST(RemoveDynamicPointsTest, NoDetectionsKeepsEverythingAndBadInputThrows) {
+  Scene s;
+  s.detections.clear();
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), Params());
+  for (PointLabel l : r.labels) EXPECT_EQ(l, PointLabel::kKept);
+  Scene t;
+  t.previous.points_world.resize(2);
+  EXPECT_THROW(RemoveDynamicPoints(t.Input(), Params()), std::invalid_argument);
+  DynamicInput in = t.Input();
+  in.camera = nullptr;
+  EXPECT_THROW(RemoveDynamicPoints(in, Params()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ademono

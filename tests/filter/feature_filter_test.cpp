@@ -1,0 +1,169 @@
+#include "ademono/filter/feature_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace ademono {
+namespace {
+
+Camera TestCamera() {
+  Camera c;
+  c.width = 640;
+  c.height = 480;
+  c.fx = c.fy = 500;
+  c.cx = 320;
+  c.cy = 240;
+  return c;
+}
+
+TEST(PointLabelNameTest, Names) {
+  EXPECT_STREQ(PointLabelName(PointLabel::kKept), "kept");
+  EXPECT_STREQ(PointLabelName(PointLabel::kEnhancementDropped), "enhancement_dropped");
+  EXPECT_STREQ(PointLabelName(PointLabel::kDynamicSmallBox), "dynamic_small_box");
+  EXPECT_STREQ(PointLabelName(PointLabel::kDynamicStage1), "dynamic_stage1");
+  EXPECT_STREQ(PointLabelName(PointLabel::kDynamicStage2), "dynamic_stage2");
+  EXPECT_STREQ(PointLabelName(PointLabel::kDistantDropped), "distant_dropped");
+}
+
+TEST(FilterOptionsTest, FromYamlAndCheck) {
+  const FilterOptions o = FilterOptions::FromYaml(
+      YAML::Load("{enable_enhancement: false, enhancement_levels: 1, box_growth: 0.05, "
+                 "dynamic_class_ids: [0, 2], z_th_m: 20, drop_probability: 0.25, seed: 7}"));
+  EXPECT_FALSE(o.enable_enhancement);
+  EXPECT_TRUE(o.enable_dynamic_removal);
+  EXPECT_EQ(o.enhancement_levels, 1);
+  EXPECT_DOUBLE_EQ(o.box_growth, 0.05);
+  EXPECT_EQ(o.dynamic_class_ids, std::vector<int>({0, 2}));
+  EXPECT_DOUBLE_EQ(o.z_th_m, 20);
+  EXPECT_DOUBLE_EQ(o.drop_probability, 0.25);
+  EXPECT_EQ(o.seed, 7u);
+  EXPECT_DOUBLE_EQ(o.d_dis_px, 8.0);  // default kept
+  EXPECT_EQ(FilterOptions::FromYaml(YAML::Node()).background_matches_t, 20);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{drop_probability: 1.5}")),
+               std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{z_th_m: far}")), std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{enhancement_keep_ratio: 0}")),
+               std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{dynamic_class_ids: person}")),
+               std::invalid_argument);
+  FilterOptions bad;
+  bad.background_matches_t = 0;
+  EXPECT_THROW(FeatureFilter{bad}, std::invalid_argument);
+}
+
+// Keypoints on a regular grid, all 40 m deep except the given shallow ones.
+struct Frame {
+  Camera camera = TestCamera();
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  std::vector<float> depths;
+  std::vector<Detection> detections;
+  Frame() {
+    std::mt19937 rng(1);
+    for (int y = 20; y < 480; y += 40)
+      for (int x = 20; x < 640; x += 40) keypoints.emplace_back(x, y, 31.f);
+    descriptors = cv::Mat(static_cast<int>(keypoints.size()), 32, CV_8UC1);
+    for (int r = 0; r < descriptors.rows; ++r)
+      for (int c = 0; c < 32; ++c) descriptors.at<uchar>(r, c) = static_cast<uchar>(rng() & 0xFF);
+    depths.assign(keypoints.size(), 5.f);
+    for (size_t i = 0; i < depths.size(); i += 2) depths[i] = 40.f;
+    Detection person;
+    person.class_id = 0;
+    person.class_name = "person";
+    person.box = cv::Rect2f(10, 10, 40, 40);  // small; grown box holds the keypoint (20, 20) only
+    detections.push_back(person);
+  }
+  FilterInput Input() const {
+    FilterInput in;
+    in.camera = &camera;
+    in.keypoints = &keypoints;
+    in.descriptors = &descriptors;
+    in.depths = &depths;
+    in.detections = &detections;
+    return in;
+  }
+};
+
+TEST(FeatureFilterTest, FiltersApplyInOrderAndStatsAddUp) {
+  const Frame f;
+  FeatureFilter filter{FilterOptions{}};
+  FilterStats stats;
+  const std::vector<PointLabel> labels = filter.Apply(f.Input(), &stats);
+  ASSERT_EQ(labels.size(), f.keypoints.size());
+  // 16 x 12 grid = 192 points, 12 per leaf block of 160 x 120: ceil(0.75 * 12) = 9 kept per leaf.
+  EXPECT_EQ(stats.removed_enhancement, 16 * 3);
+  EXPECT_EQ(stats.boxes_small, 1);
+  EXPECT_EQ(stats.boxes_large, 0);
+  // Grown box (8.9, 8.9)-(51.1, 51.1) holds (20, 20) only; it is removed unless enhancement dropped
+  // it.
+  const int small = labels[0] == PointLabel::kDynamicSmallBox ? 1 : 0;
+  EXPECT_EQ(stats.removed_small_box, small);
+  EXPECT_EQ(labels[0] == PointLabel::kEnhancementDropped || small == 1, true);
+  int deep_survivors = 0;
+  for (size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] == PointLabel::kDistantDropped) {
+      EXPECT_GT(f.depths[i], 30.f);
+    }
+    if (f.depths[i] > 30.f &&
+        (labels[i] == PointLabel::kKept || labels[i] == PointLabel::kDistantDropped))
+      ++deep_survivors;
+  }
+  EXPECT_GT(stats.removed_distant, 0);
+  EXPECT_LT(stats.removed_distant, deep_survivors);
+  EXPECT_EQ(stats.kept + stats.removed_enhancement + stats.removed_small_box +
+                stats.removed_stage1 + stats.removed_stage2 + stats.removed_distant,
+            static_cast<int>(labels.size()));
+}
+
+TEST(FeatureFilterTest, SameSeedSameLabelsAcrossFilters) {
+  const Frame f;
+  FeatureFilter a{FilterOptions{}}, b{FilterOptions{}};
+  for (int frame = 0; frame < 3; ++frame) EXPECT_EQ(a.Apply(f.Input()), b.Apply(f.Input()));
+  // The engine advances between frames: a later frame draws differently.
+  FeatureFilter c{FilterOptions{}};
+  const std::vector<PointLabel> first = c.Apply(f.Input());
+  EXPECT_NE(first, c.Apply(f.Input()));
+}
+
+TEST(FeatureFilterTest, AblationSwitches) {
+  const Frame f;
+  FilterOptions off;
+  off.enable_enhancement = off.enable_dynamic_removal = off.enable_distant_filter = false;
+  FeatureFilter none{off};
+  for (PointLabel l : none.Apply(f.Input())) EXPECT_EQ(l, PointLabel::kKept);
+  FilterOptions dyn_only = off;
+  dyn_only.enable_dynamic_removal = true;
+  FilterStats stats;
+  FeatureFilter dyn{dyn_only};
+  const std::vector<PointLabel> labels = dyn.Apply(f.Input(), &stats);
+  EXPECT_EQ(labels[0], PointLabel::kDynamicSmallBox);
+  EXPECT_EQ(stats.removed_small_box, 1);
+  EXPECT_EQ(stats.kept, static_cast<int>(labels.size()) - 1);
+}
+
+TEST(FeatureFilterTest, RejectsInconsistentInput) {
+  const Frame f;
+  FeatureFilter filter{FilterOptions{}};
+  FilterInput in = f.Input();
+  const std::vector<float> short_depths(3, 1.f);
+  in.depths = &short_depths;
+  EXPECT_THROW(filter.Apply(in), std::invalid_argument);
+  in = f.Input();
+  in.camera = nullptr;
+  EXPECT_THROW(filter.Apply(in), std::invalid_argument);
+  in = f.Input();
+  in.keypoints = nullptr;
+  EXPECT_THROW(filter.Apply(in), std::invalid_argument);
+  // No depths at all: the distant filter has nothing to drop.
+  in = f.Input();
+  in.depths = nullptr;
+  FilterStats stats;
+  filter.Apply(in, &stats);
+  EXPECT_EQ(stats.removed_distant, 0);
+}
+
+}  // namespace
+}  // namespace ademono
