@@ -7,10 +7,10 @@
 // level, `angle` in degrees [0, 360), `size` = patch size * scale of the level. Descriptors are
 // CV_8UC1 rows of 32 bytes, one per keypoint. Deterministic for the same image.
 
-#include <yaml-cpp/yaml.h>
+#include <vector>
 
 #include <opencv2/core.hpp>
-#include <vector>
+#include <yaml-cpp/yaml.h>
 
 namespace ademono {
 
