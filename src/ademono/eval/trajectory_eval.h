@@ -1,0 +1,136 @@
+#pragma once
+// Trajectory evaluation that reproduces the two reference tools:
+// - evo (MichaelGrupp/evo): timestamp association, Umeyama alignment (se3 / sim3 / origin / none),
+//   APE translation statistics, RPE translation (m) and rotation angle (deg) over a delta in
+//   frames or metres, consecutive (non-overlapping) pairs, pairs chosen on the estimate's path.
+// - kitti-odom-eval (Huangying-Zhan/kitti-odom-eval): t_rel (%) and r_rel (deg/100 m) over
+//   sub-sequences of 100..800 m starting every 10 frames, with its alignments none / scale / 6dof
+//   / 7dof, and its ATE (RMSE) and consecutive-frame RPE means.
+//
+// Poses are world_from_cam 4x4 matrices kept exactly as read from the files (not
+// re-orthonormalised), because both tools work on the raw matrices and their results depend on
+// it at the 1e-6 level: evo inverts poses as [R^T | -R^T t], kitti-odom-eval with a general
+// matrix inverse and measures rotation by arccos((trace - 1) / 2).
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ademono/io/trajectory.h"
+
+namespace ademono {
+
+// Timestamped raw poses. For KITTI files timestamps are the line indices 0, 1, 2, ...
+struct PoseSeries {
+  std::vector<double> timestamps;
+  std::vector<Eigen::Matrix4d> world_from_cam;
+  size_t size() const { return world_from_cam.size(); }
+};
+PoseSeries ToPoseSeries(const Trajectory& trajectory);
+// Reads a trajectory file without touching the rotation matrices (KITTI) or through the TUM /
+// EuRoC quaternion readers. Same errors as io/trajectory.h.
+PoseSeries ReadPoseSeries(const std::filesystem::path& path, TrajectoryFormat format);
+
+// Population statistics (numpy: np.std with ddof = 0, np.median averaging the middle pair).
+struct ErrorStats {
+  double rmse = 0, mean = 0, median = 0, max = 0, min = 0, std = 0;
+  size_t count = 0;
+};
+ErrorStats ComputeStats(const std::vector<double>& errors);
+
+// evo's sync.associate_trajectories: every stamp of the shorter trajectory is matched to the
+// nearest stamp of the longer one (first index on ties) if |dt| <= max_diff. A pose of the longer
+// trajectory can be matched more than once. Returns index pairs (gt index, est index) in the
+// order of the shorter trajectory.
+std::vector<std::pair<size_t, size_t>> AssociateLikeEvo(const std::vector<double>& gt_stamps,
+                                                        const std::vector<double>& est_stamps,
+                                                        double max_diff);
+
+// Least-squares similarity dst ~ scale * rotation * src + translation (Umeyama 1991), as evo and
+// kitti-odom-eval implement it. `with_scale` false gives scale 1 (the se3 / Horn solution).
+// Throws std::invalid_argument for fewer than 3 points or a degenerate (collinear) point set.
+struct Similarity {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  double scale = 1.0;
+};
+Similarity UmeyamaAlignment(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst,
+                            bool with_scale);
+
+enum class Alignment { kNone, kSe3, kSim3, kOrigin };
+enum class DeltaUnit { kFrames, kMeters };
+enum class KittiAlignment { kNone, kScale, kSixDof, kSevenDof };
+// "none|se3|sim3|origin", "frames|m", "none|scale|6dof|7dof"; std::invalid_argument otherwise.
+Alignment ParseAlignment(const std::string& name);
+DeltaUnit ParseDeltaUnit(const std::string& name);
+KittiAlignment ParseKittiAlignment(const std::string& name);
+std::string ToString(Alignment alignment);
+std::string ToString(KittiAlignment alignment);
+// The kitti-odom-eval variant matching an evo alignment (origin -> none: it always aligns the
+// first frames).
+KittiAlignment KittiAlignmentFor(Alignment alignment);
+
+struct EvalOptions {
+  Alignment alignment = Alignment::kSe3;
+  // Match poses by timestamp (TUM, EuRoC) or pose i to pose i (KITTI: sizes must be equal).
+  bool associate_by_timestamp = true;
+  double max_diff = 0.01;  // seconds, evo's default for TUM
+  double rpe_delta = 1.0;
+  DeltaUnit rpe_unit = DeltaUnit::kFrames;
+  bool rpe_pairs_from_reference = false;  // evo --pairs_from_reference
+  bool kitti_metrics = false;
+  KittiAlignment kitti_alignment = KittiAlignment::kSixDof;
+  // Throws std::invalid_argument describing the first bad option.
+  void Check() const;
+};
+
+struct KittiOdometryResult {
+  double t_rel_percent = 0;
+  double r_rel_deg_per_100m = 0;
+  double ate_m = 0;
+  double rpe_m = 0;
+  double rpe_deg = 0;
+  size_t segments = 0;  // number of (start frame, length) sub-sequences averaged
+};
+
+struct EvalResult {
+  size_t gt_poses = 0, est_poses = 0, matched_poses = 0;
+  Alignment alignment = Alignment::kNone;
+  Similarity gt_from_est;  // the alignment applied to the estimate
+  ErrorStats ape;          // metres
+  std::vector<double> ape_errors;
+  ErrorStats rpe_trans;    // metres
+  ErrorStats rpe_rot_deg;  // degrees
+  double rpe_delta = 1.0;
+  DeltaUnit rpe_unit = DeltaUnit::kFrames;
+  std::optional<KittiOdometryResult> kitti;
+  KittiAlignment kitti_alignment = KittiAlignment::kNone;
+  PoseSeries gt_matched;   // associated ground truth
+  PoseSeries est_aligned;  // associated estimate after alignment
+};
+
+// Throws InputError-free std::invalid_argument / std::runtime_error on unusable input (no
+// matching timestamps, different KITTI lengths, too few poses to align); callers that know the
+// file names (the CLI) add them.
+EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
+                                const EvalOptions& options);
+EvalResult EvaluateTrajectories(const Trajectory& gt, const Trajectory& est,
+                                const EvalOptions& options);
+
+// kitti-odom-eval on index-matched poses (gt[i] <-> est[i], equal sizes).
+KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
+                                          std::vector<Eigen::Matrix4d> est,
+                                          KittiAlignment alignment);
+
+nlohmann::json ToJson(const ErrorStats& stats);
+// Keys: ape, rpe_trans, rpe_rot_deg (rmse/mean/median/max/min/std), matched_poses, alignment,
+// scale (sim3), rpe_delta, rpe_unit, kitti (t_rel_percent, r_rel_deg_per_100m, ate_m, rpe_m,
+// rpe_deg, alignment) when computed.
+nlohmann::json ToJson(const EvalResult& result);
+// Human-readable multi-line summary.
+std::string FormatReport(const EvalResult& result);
+
+}  // namespace ademono
