@@ -83,7 +83,7 @@ def one_hot(class_id, prob, num_classes=8, rest=0.05):
 
 
 # Detector rows (cx, cy, w, h in network-input pixels). The tests expect, at score 0.3, NMS 0.45:
-#   row 0 kept (class 1, 0.9 * 0.8 = 0.72); row 1 suppressed by row 0 (same class, IoU 0.82);
+#   row 0 kept (class 1, 0.9 * 0.8 = 0.72); row 1 suppressed by row 0 (same class, IoU 0.90);
 #   row 2 kept (class 2, 0.6 * 0.9 = 0.54, overlaps row 0 but another class); row 3 below the
 #   score threshold (0.5 * 0.5 = 0.25).
 DET_BOXES = [

@@ -2,10 +2,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "ademono/core/error.h"
+#include "ademono/core/file_util.h"
 #include "ademono/dnn/model_arg.h"
 
 namespace ademono {
@@ -137,6 +141,65 @@ cv::Mat OnnxDepthProvider::DepthFromImage(const cv::Mat& image, const Camera& ca
     }
   }
   return depth;
+}
+
+cv::Mat DepthToMillimetres(const cv::Mat& depth_m) {
+  CV_Assert(depth_m.type() == CV_32FC1);
+  cv::Mat mm(depth_m.size(), CV_16UC1);
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* d = depth_m.ptr<float>(r);
+    uint16_t* out = mm.ptr<uint16_t>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      const double value = std::round(static_cast<double>(d[c]) * 1000.0);
+      out[c] =
+          std::isfinite(value) && value > 0 && value < 65535 ? static_cast<uint16_t>(value) : 0;
+    }
+  }
+  return mm;
+}
+
+void WriteDepthMap(const std::filesystem::path& path, const cv::Mat& depth_m) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".png") {
+    WriteImageAtomic(path, DepthToMillimetres(depth_m));
+  } else if (ext == ".tif" || ext == ".tiff") {
+    WriteImageAtomic(path, depth_m);
+  } else {
+    ThrowInputError(path, "depth output must be .png (uint16 mm) or .tif/.tiff (float m)");
+  }
+}
+
+cv::Mat ColouriseDepth(const cv::Mat& depth_m) {
+  CV_Assert(depth_m.type() == CV_32FC1);
+  std::vector<float> valid;
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* d = depth_m.ptr<float>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      if (d[c] > 0 && std::isfinite(d[c])) valid.push_back(d[c]);
+    }
+  }
+  cv::Mat preview(depth_m.size(), CV_8UC3, cv::Scalar::all(0));
+  if (valid.empty()) return preview;
+  auto percentile = [&](double q) {
+    const size_t k = static_cast<size_t>(q * (valid.size() - 1));
+    std::nth_element(valid.begin(), valid.begin() + k, valid.end());
+    return valid[k];
+  };
+  const float lo = percentile(0.02), hi = std::max(percentile(0.98), lo + 1e-3f);
+  cv::Mat gray(depth_m.size(), CV_8UC1);
+  for (int r = 0; r < depth_m.rows; ++r) {
+    const float* d = depth_m.ptr<float>(r);
+    uint8_t* g = gray.ptr<uint8_t>(r);
+    for (int c = 0; c < depth_m.cols; ++c) {
+      // Near = 255 (red end of turbo).
+      g[c] = cv::saturate_cast<uint8_t>(255.0 * (hi - std::clamp(d[c], lo, hi)) / (hi - lo));
+    }
+  }
+  cv::applyColorMap(gray, preview, cv::COLORMAP_TURBO);
+  preview.setTo(cv::Scalar::all(0), depth_m <= 0);
+  return preview;
 }
 
 std::unique_ptr<DepthProvider> MakeOnnxDepthProvider(const std::string& argument,

@@ -40,6 +40,15 @@ class OnnxDepthProvider : public DepthProvider {
   std::string spec_source_;
 };
 
+// Depth map files written by `ademono depth` / `ademono infer` (read back by cache:DIR):
+// ".png": uint16 millimetres, 0 = invalid (depths beyond 65.534 m are written as invalid);
+// ".tif"/".tiff": float32 metres. Written atomically. InputError for another extension.
+void WriteDepthMap(const std::filesystem::path& path, const cv::Mat& depth_m);
+cv::Mat DepthToMillimetres(const cv::Mat& depth_m);
+// BGR preview: turbo colour map over the 2nd..98th percentile of the valid depths (near = red),
+// invalid pixels black.
+cv::Mat ColouriseDepth(const cv::Mat& depth_m);
+
 // The `model:` branch of MakeDepthProvider: `argument` is "FILE.onnx[,spec=SPEC.yaml]".
 std::unique_ptr<DepthProvider> MakeOnnxDepthProvider(const std::string& argument,
                                                      const DepthFactoryContext& context);

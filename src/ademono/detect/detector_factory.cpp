@@ -1,5 +1,7 @@
 #include "ademono/detect/detector_factory.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -85,6 +87,40 @@ void DetectorOptions::Check() const {
     throw std::invalid_argument("detector threads must be in [1, 64], got " +
                                 std::to_string(num_threads));
   }
+}
+
+std::vector<int> ParseClassList(const std::string& text) {
+  if (text == "all") return {};
+  if (text == "dynamic") return DefaultDynamicClassIds();
+  const auto& names = CocoClassNames();
+  std::vector<int> ids;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = text.find(',', start);
+    std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    start = comma == std::string::npos ? text.size() + 1 : comma + 1;
+    while (!item.empty() && item.front() == ' ') item.erase(item.begin());
+    while (!item.empty() && item.back() == ' ') item.pop_back();
+    if (item.empty()) throw InputError("empty class name in '" + text + "'");
+    int id = -1;
+    if (std::all_of(item.begin(), item.end(), [](char c) { return std::isdigit(c); })) {
+      id = item.size() <= 3 ? std::stoi(item) : -1;
+      if (id < 0 || id >= static_cast<int>(names.size())) {
+        throw InputError("class id " + item + " is outside the 80 COCO classes (0-79)");
+      }
+    } else {
+      const auto it = std::find(names.begin(), names.end(), item);
+      if (it == names.end()) {
+        throw InputError("unknown class '" + item +
+                         "' (expected a COCO class name or id, 'all' "
+                         "or 'dynamic')");
+      }
+      id = static_cast<int>(it - names.begin());
+    }
+    if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+  }
+  return ids;
 }
 
 std::unique_ptr<Detector> MakeDetector(const std::string& spec, const DetectorOptions& options) {

@@ -156,14 +156,16 @@ std::vector<Detection> DecodeYolov8(const Tensor& output, float score_threshold)
   return candidates;
 }
 
-std::vector<Detection> NmsPerClass(std::vector<Detection> candidates, float iou_threshold) {
+std::vector<Detection> Nms(std::vector<Detection> candidates, float iou_threshold,
+                           bool class_agnostic) {
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Detection& a, const Detection& b) { return a.score > b.score; });
   std::vector<Detection> kept;
   for (auto& candidate : candidates) {
     bool suppressed = false;
     for (const auto& k : kept) {
-      if (k.class_id == candidate.class_id && Iou(k.box, candidate.box) > iou_threshold) {
+      if ((class_agnostic || k.class_id == candidate.class_id) &&
+          Iou(k.box, candidate.box) > iou_threshold) {
         suppressed = true;
         break;
       }
@@ -259,7 +261,8 @@ std::vector<Detection> YoloDetector::DetectImage(const cv::Mat& image) const {
              options_.class_ids.end();
     });
   }
-  std::vector<Detection> detections = NmsPerClass(std::move(candidates), options_.nms_iou);
+  std::vector<Detection> detections =
+      Nms(std::move(candidates), options_.nms_iou, options_.class_agnostic_nms);
   const cv::Rect2f bounds(0.f, 0.f, static_cast<float>(image.cols), static_cast<float>(image.rows));
   for (auto& d : detections) {
     const cv::Point2d tl = transform.ToOriginal({d.box.x, d.box.y});

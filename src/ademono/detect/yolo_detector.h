@@ -11,7 +11,8 @@
 // - yolov8: as yolov5 for the input. Output 1x(4+C)xN (transposed): centre x, y, w, h, class
 //           scores; no objectness.
 // Each anchor keeps its best class; candidates above the score threshold go through class-aware
-// NMS (boxes of different classes never suppress each other), then the class filter.
+// NMS (boxes of different classes never suppress each other; optionally class-agnostic), then
+// the class filter.
 // Boxes are returned in original-image pixels, clipped to the image, sorted by score.
 
 #include <filesystem>
@@ -45,9 +46,11 @@ std::vector<Detection> DecodeYolox(const Tensor& output, cv::Size input_size,
 std::vector<Detection> DecodeYolov5(const Tensor& output, float score_threshold);
 std::vector<Detection> DecodeYolov8(const Tensor& output, float score_threshold);
 
-// Class-aware greedy NMS: within each class, a box is dropped when its IoU with a higher-scoring
-// kept box exceeds `iou_threshold`. Stable: ties keep the earlier candidate. Sorted by score.
-std::vector<Detection> NmsPerClass(std::vector<Detection> candidates, float iou_threshold);
+// Greedy NMS: a box is dropped when its IoU with a higher-scoring kept box of the same class
+// (any class when `class_agnostic`) exceeds `iou_threshold`. Stable: ties keep the earlier
+// candidate. Sorted by score.
+std::vector<Detection> Nms(std::vector<Detection> candidates, float iou_threshold,
+                           bool class_agnostic = false);
 
 class YoloDetector : public Detector {
  public:
