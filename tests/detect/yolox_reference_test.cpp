@@ -39,7 +39,7 @@ TEST(YoloxReferenceTest, ReproducesExpectedDetections) {
     const auto detections = detector.DetectImage(image);
     const auto& want = image_json["detections"];
     EXPECT_EQ(detections.size(), want.size());
-    for (const auto& d : detections) std::vector<bool> used(detections.size(), false);
+    std::vector<bool> used(detections.size(), false);
     for (const auto& w : want) {
       const auto box = w["box_xywh"].get<std::vector<float>>();
       const cv::Rect2f want_box(box[0], box[1], box[2], box[3]);
