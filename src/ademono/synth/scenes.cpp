@@ -172,6 +172,14 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
           textures.Make(TextureStyle::kSidewalk, segment, segment, 0.02, {0.85f, 0.9f, 0.95f})));
     }
   }
+  // Open ground (lawns, yards) behind the sidewalks, under and between the buildings.
+  for (double x = road_begin; x < road_end + 20; x += 2 * segment) {
+    for (int side : {-1, 1}) {
+      scene.static_boxes.push_back(MakeBox(
+          At(x + segment, 36.0 * side, -0.05), {segment, 25.0, 0.05},
+          textures.Make(TextureStyle::kFloor, 2 * segment, 50.0, 0.04, {0.45f, 0.8f, 0.55f})));
+    }
+  }
   // Buildings along both sides; facades 11 to 40 m to the side.
   for (int side : {-1, 1}) {
     double x = road_begin + rng.Uniform(0, 10);
