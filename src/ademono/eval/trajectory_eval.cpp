@@ -382,9 +382,7 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
     }
   } else {
     if (gt.size() != est.size()) {
-      throw std::invalid_argument("trajectories have different lengths (" +
-                                  std::to_string(gt.size()) + " and " + std::to_string(est.size()) +
-                                  " poses)");
+      throw std::invalid_argument("trajectories have different lengths");
     }
     for (size_t i = 0; i < gt.size(); ++i) pairs.emplace_back(i, i);
   }

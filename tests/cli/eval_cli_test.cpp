@@ -1,0 +1,173 @@
+// End-to-end tests of `ademono eval`: results, JSON and SVG outputs, and bad input (one-line
+// error naming the file, non-zero exit, no output file left behind).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using ::testing::HasSubstr;
+
+const fs::path kTraj = fs::path(ADEMONO_SHARED_DIR) / "data" / "trajectories";
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class EvalCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(kTraj / "expected.json")) GTEST_SKIP() << "no shared data";
+    dir_ = fs::temp_directory_path() /
+           ("ademono_eval_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  RunResult Run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd =
+        std::string(ADEMONO_CLI) + " eval " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = Read(out);
+    r.err = Read(err);
+    return r;
+  }
+  static std::string Read(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  static size_t Lines(const std::string& text) {
+    return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+  }
+  static nlohmann::json Expected() {
+    std::ifstream in(kTraj / "expected.json");
+    return nlohmann::json::parse(in);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(EvalCliTest, TumSe3WritesJsonAndPlot) {
+  const fs::path json = dir_ / "m.json", svg = dir_ / "p.svg";
+  const RunResult r =
+      Run("--gt " + (kTraj / "evo/freiburg1_xyz-groundtruth.txt").string() + " --est " +
+          (kTraj / "evo/freiburg1_xyz-rgbdslam.txt").string() +
+          " --format tum --align se3 --json " + json.string() + " --plot " + svg.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("APE translation"));
+  const nlohmann::json j = nlohmann::json::parse(Read(json));
+  const nlohmann::json e = Expected()["evo"]["fr1_xyz_rgbdslam"];
+  EXPECT_EQ(j["alignment"], "se3");
+  EXPECT_NEAR(j["ape"]["rmse"].get<double>(), e["ape_se3"]["rmse"].get<double>(), 1e-8);
+  EXPECT_NEAR(j["rpe_trans"]["mean"].get<double>(), e["rpe_trans_1frame"]["mean"].get<double>(),
+              1e-8);
+  EXPECT_NEAR(j["rpe_rot_deg"]["max"].get<double>(), e["rpe_rot_deg_1frame"]["max"].get<double>(),
+              1e-6);
+  for (const char* key : {"rmse", "mean", "median", "max", "min", "std"}) {
+    EXPECT_TRUE(j["ape"].contains(key)) << key;
+  }
+  EXPECT_FALSE(j.contains("kitti"));
+  EXPECT_FALSE(j.contains("scale"));
+  EXPECT_GT(j["matched_poses"].get<int>(), 700);
+  const std::string plot = Read(svg);
+  EXPECT_EQ(plot.rfind("<?xml", 0), 0u);
+  EXPECT_THAT(plot, HasSubstr("</svg>"));
+  EXPECT_THAT(plot, HasSubstr("<polyline"));
+  // No temp files left beside the outputs.
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_))
+    files += entry.path().filename().string().rfind(".tmp", 0) == 0;
+  EXPECT_EQ(files, 0u);
+}
+
+TEST_F(EvalCliTest, KittiMetricsAndSim3Scale) {
+  const fs::path json = dir_ / "k.json";
+  const RunResult r = Run("--gt " + (kTraj / "kitti-odom-eval/gt/10.txt").string() + " --est " +
+                          (kTraj / "kitti-odom-eval/example_1/10.txt").string() +
+                          " --format kitti --align sim3 --kitti-metrics --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(Read(json));
+  const nlohmann::json e = Expected()["kitti_odom_eval"]["example_1"]["7dof"]["10"];
+  EXPECT_NEAR(j["kitti"]["t_rel_percent"].get<double>(), e["t_rel_percent"].get<double>(), 5e-4);
+  EXPECT_NEAR(j["kitti"]["r_rel_deg_per_100m"].get<double>(), e["r_rel_deg_per_100m"].get<double>(),
+              5e-4);
+  EXPECT_EQ(j["kitti"]["alignment"], "7dof");
+  EXPECT_TRUE(j.contains("scale"));
+  EXPECT_GT(j["scale"].get<double>(), 0.5);
+}
+
+TEST_F(EvalCliTest, NoMatchingTimestampsNamesBothFiles) {
+  const fs::path json = dir_ / "none.json";
+  const std::string gt = (kTraj / "evo/freiburg1_xyz-groundtruth.txt").string();
+  const std::string est = (kTraj / "evo/fr2_desk_ORB.txt").string();
+  const RunResult r = Run("--gt " + gt + " --est " + est + " --json " + json.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(Lines(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("ademono eval: error: no matching timestamps within 0.01 s"));
+  EXPECT_THAT(r.err, HasSubstr(gt));
+  EXPECT_THAT(r.err, HasSubstr(est));
+  EXPECT_FALSE(fs::exists(json));
+}
+
+TEST_F(EvalCliTest, KittiFilesOfDifferentLengths) {
+  const fs::path json = dir_ / "len.json";
+  const RunResult r = Run("--gt " + (kTraj / "kitti-odom-eval/gt/09.txt").string() + " --est " +
+                          (kTraj / "kitti-odom-eval/example_1/10.txt").string() +
+                          " --format kitti --json " + json.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(Lines(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("different lengths"));
+  EXPECT_THAT(r.err, HasSubstr("09.txt (1591 poses)"));
+  EXPECT_THAT(r.err, HasSubstr("10.txt (1201 poses)"));
+  EXPECT_FALSE(fs::exists(json));
+}
+
+TEST_F(EvalCliTest, MalformedAndMissingFiles) {
+  const fs::path json = dir_ / "bad.json", plot = dir_ / "bad.svg";
+  const fs::path bad = dir_ / "est.txt";
+  std::ofstream(bad) << "# ts tx ty tz qx qy qz qw\n1.0 0 0 0 0 0 0 1\n2.0 0 0 zero 0 0 0 1\n";
+  const std::string gt = (kTraj / "evo/freiburg1_xyz-groundtruth.txt").string();
+  RunResult r = Run("--gt " + gt + " --est " + bad.string() + " --json " + json.string() +
+                    " --plot " + plot.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(Lines(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(bad.string() + ":3: field 4 'zero' is not a finite number"));
+  EXPECT_FALSE(fs::exists(json));
+  EXPECT_FALSE(fs::exists(plot));
+
+  std::ofstream(bad) << "1 0 0 0 0 1 0 0 0 0 1\n";
+  r = Run("--gt " + (kTraj / "kitti-odom-eval/gt/09.txt").string() + " --est " + bad.string() +
+          " --format kitti --json " + json.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.err, HasSubstr(bad.string() + ":1: expected 12 fields, found 11"));
+  EXPECT_FALSE(fs::exists(json));
+
+  const std::string missing = (dir_ / "missing.txt").string();
+  r = Run("--gt " + missing + " --est " + gt + " --json " + json.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(Lines(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(missing + ": no such file"));
+  EXPECT_FALSE(fs::exists(json));
+}
+
+}  // namespace
