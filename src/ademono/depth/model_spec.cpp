@@ -103,6 +103,7 @@ void DepthModelSpec::Check() const {
     if (side_length < 0) fail("input.side_length must be >= 0");
   }
   if (multiple_of < 1) fail("input.multiple_of must be >= 1");
+  if (pad_none && resize != Resize::kMultiple) fail("input.pad: none needs resize: multiple");
   for (int c = 0; c < 3; ++c) {
     if (!(std[c] > 0)) fail("input.std must be positive");
   }
@@ -140,11 +141,16 @@ DepthModelSpec DepthModelSpec::FromYaml(const YAML::Node& node, const std::files
       ReadChoice<bool>(in, "side", "input", path, {{"long", true}, {"short", false}}, true);
   Read(in, "side_length", "input", path, &spec.side_length);
   Read(in, "multiple_of", "input", path, &spec.multiple_of);
-  spec.pad = ReadChoice<PadPlacement>(in, "pad", "input", path,
-                                      {{"centre", PadPlacement::kCentre},
-                                       {"center", PadPlacement::kCentre},
-                                       {"bottom_right", PadPlacement::kTopLeft}},
-                                      spec.pad);
+  std::string pad_text;
+  Read(in, "pad", "input", path, &pad_text);
+  spec.pad_none = pad_text == "none";
+  if (!spec.pad_none) {
+    spec.pad = ReadChoice<PadPlacement>(in, "pad", "input", path,
+                                        {{"centre", PadPlacement::kCentre},
+                                         {"center", PadPlacement::kCentre},
+                                         {"bottom_right", PadPlacement::kTopLeft}},
+                                        spec.pad);
+  }
   spec.pad_value = ReadTriple(in, "pad_value", "input", path, spec.pad_value);
   spec.interpolation = ReadChoice<int>(in, "interpolation", "input", path,
                                        {{"linear", cv::INTER_LINEAR},
@@ -216,6 +222,18 @@ void DepthModelSpec::InputGeometry(cv::Size image_size, cv::Size* input_size,
         const int side = long_side ? std::max(image_size.width, image_size.height)
                                    : std::min(image_size.width, image_size.height);
         s = static_cast<double>(side_length) / side;
+      }
+      if (pad_none) {
+        // Nearest multiple, but not below side_length when that bounds the short side.
+        const int min_side = long_side ? multiple_of : std::max(multiple_of, side_length);
+        auto constrain = [&](double x) {
+          int y = static_cast<int>(std::lround(x / multiple_of)) * multiple_of;
+          if (y < min_side) y = static_cast<int>(std::ceil(x / multiple_of)) * multiple_of;
+          return std::max(y, multiple_of);
+        };
+        *input_size = {constrain(image_size.width * s), constrain(image_size.height * s)};
+        *content_size = *input_size;
+        return;
       }
       *content_size = {std::max(1, static_cast<int>(std::lround(image_size.width * s))),
                        std::max(1, static_cast<int>(std::lround(image_size.height * s)))};

@@ -14,7 +14,10 @@
 //     side: long           # multiple: which side gets side_length (long | short)
 //     side_length: 518
 //     multiple_of: 14
-//     pad: centre          # letterbox / multiple: centre | bottom_right
+//     pad: centre          # letterbox / multiple: centre | bottom_right; multiple also takes
+//                          # none: round each side to the nearest multiple instead of padding
+//                          # (slight stretch, as Depth Anything does; never below side_length
+//                          # for side: short)
 //     pad_value: [0, 0, 0] # 0..255 units, in the model's colour order
 //     interpolation: cubic # linear | cubic | area | nearest
 //     color: rgb           # colour order fed to the network: rgb | bgr
@@ -59,6 +62,7 @@ struct DepthModelSpec {
   int side_length = 0;    // multiple: 0 = keep the image size
   int multiple_of = 1;
   PadPlacement pad = PadPlacement::kCentre;
+  bool pad_none = false;  // multiple: round to the multiple (stretch) instead of padding
   std::array<double, 3> pad_value{0, 0, 0};
   int interpolation = 1;  // cv::INTER_LINEAR
   bool rgb = true;

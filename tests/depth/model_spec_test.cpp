@@ -1,0 +1,148 @@
+#include "ademono/depth/model_spec.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <opencv2/imgproc.hpp>
+
+#include "ademono/core/error.h"
+
+namespace ademono {
+namespace {
+
+namespace fs = std::filesystem;
+
+DepthModelSpec Parse(const std::string& text) {
+  return DepthModelSpec::FromYaml(YAML::Load(text), "spec.yaml");
+}
+
+std::string ParseError(const std::string& text) {
+  try {
+    Parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ModelSpecTest, DefaultsAreImageNetMetric) {
+  const DepthModelSpec spec = Parse("name: x\n");
+  EXPECT_EQ(spec.resize, DepthModelSpec::Resize::kFixed);
+  EXPECT_TRUE(spec.rgb);
+  EXPECT_NEAR(spec.mean[0], 0.485 * 255, 1e-9);
+  EXPECT_NEAR(spec.std[2], 0.225 * 255, 1e-9);
+  EXPECT_EQ(spec.kind, DepthModelSpec::Kind::kMetric);
+  EXPECT_EQ(spec.ToDepth(2.5, 1.0), 2.5);
+}
+
+TEST(ModelSpecTest, ParsesEveryField) {
+  const DepthModelSpec spec = Parse(R"(
+name: full
+input:
+  resize: multiple
+  side: short
+  side_length: 384
+  multiple_of: 32
+  pad: bottom_right
+  pad_value: [1, 2, 3]
+  interpolation: cubic
+  color: bgr
+  units: byte
+  mean: [10, 20, 30]
+  std: 2
+output:
+  kind: inverse
+  scale: 3.0
+  min_depth: 0.2
+  max_depth: 9
+)");
+  EXPECT_EQ(spec.name, "full");
+  EXPECT_EQ(spec.resize, DepthModelSpec::Resize::kMultiple);
+  EXPECT_FALSE(spec.long_side);
+  EXPECT_EQ(spec.side_length, 384);
+  EXPECT_EQ(spec.multiple_of, 32);
+  EXPECT_EQ(spec.pad, PadPlacement::kTopLeft);
+  EXPECT_EQ(spec.pad_value[2], 3.0);
+  EXPECT_EQ(spec.interpolation, cv::INTER_CUBIC);
+  EXPECT_FALSE(spec.rgb);
+  EXPECT_EQ(spec.mean[1], 20.0);
+  EXPECT_EQ(spec.std[0], 2.0);
+  EXPECT_EQ(spec.kind, DepthModelSpec::Kind::kInverse);
+  EXPECT_DOUBLE_EQ(spec.ToDepth(2.0, 1.0), 1.5);
+  EXPECT_EQ(spec.ToDepth(0.0, 1.0), 0.0);
+  EXPECT_EQ(spec.min_depth, 0.2);
+  cv::Size input, content;
+  spec.InputGeometry({640, 480}, &input, &content);
+  EXPECT_EQ(content, cv::Size(512, 384));
+  EXPECT_EQ(input, cv::Size(512, 384));
+}
+
+TEST(ModelSpecTest, UnitMeanStdAreConvertedTo0To255) {
+  const DepthModelSpec spec = Parse("input:\n  units: unit\n  mean: [0.5, 0.5, 0.5]\n  std: 0.5\n");
+  EXPECT_DOUBLE_EQ(spec.mean[0], 127.5);
+  EXPECT_DOUBLE_EQ(spec.std[1], 127.5);
+}
+
+TEST(ModelSpecTest, DisparityAndCanonicalFocal) {
+  const DepthModelSpec disparity = Parse("output:\n  kind: disparity\n  baseline_focal: 40\n");
+  EXPECT_DOUBLE_EQ(disparity.ToDepth(8.0, 1.0), 5.0);
+  const DepthModelSpec canonical = Parse("output:\n  kind: metric\n  canonical_focal: 1000\n");
+  EXPECT_DOUBLE_EQ(canonical.ToDepth(4.0, 0.5), 2.0);
+}
+
+TEST(ModelSpecTest, LetterboxGeometry) {
+  const DepthModelSpec spec = Parse("input:\n  resize: letterbox\n  width: 1064\n  height: 616\n");
+  cv::Size input, content;
+  spec.InputGeometry({640, 480}, &input, &content);
+  EXPECT_EQ(input, cv::Size(1064, 616));
+  EXPECT_EQ(content, cv::Size(821, 616));
+}
+
+TEST(ModelSpecTest, ErrorsNameTheFileAndKey) {
+  EXPECT_EQ(ParseError("input:\n  colour: rgb\n"), "spec.yaml: unknown key 'input.colour'");
+  EXPECT_THAT(ParseError("output:\n  kind: depthish\n"),
+              testing::HasSubstr("spec.yaml: 'output.kind' is 'depthish', expected one of"));
+  EXPECT_THAT(ParseError("input:\n  width: wide\n"), testing::HasSubstr("'input.width'"));
+  EXPECT_THAT(ParseError("input:\n  mean: [1, 2]\n"), testing::HasSubstr("'input.mean'"));
+  EXPECT_THAT(ParseError("input:\n  std: 0\n"), testing::HasSubstr("std"));
+  EXPECT_THAT(ParseError("output:\n  kind: disparity\n"), testing::HasSubstr("baseline_focal"));
+  EXPECT_THAT(ParseError("output:\n  min_depth: 5\n  max_depth: 1\n"),
+              testing::HasSubstr("min_depth"));
+  EXPECT_THAT(ParseError("input:\n  width: 10\n"), testing::HasSubstr("height"));
+  EXPECT_THAT(ParseError("output:\n  kind: inverse\n  canonical_focal: 100\n"),
+              testing::HasSubstr("canonical_focal"));
+  EXPECT_THAT(ParseError("- 1\n- 2\n"), testing::HasSubstr("mapping"));
+  EXPECT_THROW(DepthModelSpec::Load("/no/such/spec.yaml"), InputError);
+}
+
+TEST(ModelSpecTest, PadNoneRoundsToTheMultipleLikeDepthAnything) {
+  const DepthModelSpec spec = Parse(
+      "input:\n  resize: multiple\n  side: short\n  side_length: 518\n  multiple_of: 14\n"
+      "  pad: none\n");
+  cv::Size input, content;
+  // 640x480 -> x 518/480 -> 690.7 x 518 -> nearest multiples of 14: 686 x 518.
+  spec.InputGeometry({640, 480}, &input, &content);
+  EXPECT_EQ(input, cv::Size(686, 518));
+  EXPECT_EQ(content, input);
+  // Portrait 480x640 -> 518 x 690.7.
+  spec.InputGeometry({480, 640}, &input, &content);
+  EXPECT_EQ(input, cv::Size(518, 686));
+  EXPECT_THAT(ParseError("input:\n  resize: fixed\n  pad: none\n"), testing::HasSubstr("pad"));
+}
+
+TEST(ModelSpecTest, ShippedSpecsLoad) {
+  const fs::path dir = fs::path(ADEMONO_SOURCE_DIR) / "configs/models";
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(DepthModelSpec::Load(entry.path()));
+    ++count;
+  }
+  EXPECT_GE(count, 4);
+}
+
+}  // namespace
+}  // namespace ademono
