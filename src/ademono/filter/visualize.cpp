@@ -79,8 +79,15 @@ cv::Mat DrawFilterResult(const cv::Mat& image, const std::vector<cv::KeyPoint>& 
     const std::string text =
         (det.class_name.empty() ? std::to_string(det.class_id) : det.class_name) +
         (b.small ? " (small)" : " (large)");
-    cv::putText(canvas, text, cv::Point(cvRound(tl.x) + 2, std::max(12, cvRound(tl.y) - 4)),
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, box_color, 1, cv::LINE_AA);
+    // White text on a box-coloured tag above the box (inside it when the box touches the top).
+    int baseline = 0;
+    const cv::Size text_size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, &baseline);
+    const int tag_h = text_size.height + baseline + 4;
+    const int tag_y = cvRound(tl.y) - tag_h >= 0 ? cvRound(tl.y) - tag_h : cvRound(tl.y);
+    cv::rectangle(canvas, cv::Rect(cvRound(tl.x), tag_y, text_size.width + 4, tag_h), box_color,
+                  cv::FILLED);
+    cv::putText(canvas, text, cv::Point(cvRound(tl.x) + 2, tag_y + text_size.height + 2),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
 
   std::array<int, kAllLabels.size()> counts{};
