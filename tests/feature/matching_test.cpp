@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace ademono {
@@ -70,6 +71,8 @@ TEST(KeypointGridTest, ExactCases) {
   EXPECT_EQ(grid.FeaturesInArea(10, 10, 6, 1, 1), std::vector<size_t>({1}));
   EXPECT_EQ(grid.FeaturesInArea(0, 480, 3), std::vector<size_t>({3}));
   EXPECT_TRUE(grid.FeaturesInArea(300, 300, 50).empty());
+  EXPECT_EQ(grid.FeaturesInArea(10, 10, 1e30f).size(), 4u);  // huge radius: no overflow
+  EXPECT_TRUE(grid.FeaturesInArea(std::nanf(""), 10, 5).empty());
   EXPECT_THROW(KeypointGrid(kps, cv::Size(0, 480)), std::invalid_argument);
 }
 

@@ -87,6 +87,21 @@ TEST(OrbExtractorTest, SpreadsOverTheImageAndUsesAllLevels) {
   EXPECT_GT(level0, 150);
 }
 
+TEST(OrbExtractorTest, WideKittiSizedImage) {
+  // KITTI-like 1241 x 376 with 2000 features: several initial quadtree columns.
+  cv::Mat wide;
+  cv::resize(LoadFrame(), wide, cv::Size(1241, 376));
+  OrbOptions options;
+  options.num_features = 2000;
+  const Features f = Extract(wide, options);
+  EXPECT_GE(f.keypoints.size(), 1800u);
+  EXPECT_LE(f.keypoints.size(), 2200u);
+  int columns[8] = {};
+  for (const auto& kp : f.keypoints)
+    ++columns[std::min(7, static_cast<int>(kp.pt.x * 8 / wide.cols))];
+  for (int c = 0; c < 8; ++c) EXPECT_GT(columns[c], 50) << "column " << c;
+}
+
 TEST(OrbExtractorTest, Deterministic) {
   const cv::Mat image = LoadFrame();
   const Features a = Extract(image), b = Extract(image);

@@ -164,13 +164,15 @@ KeypointGrid::KeypointGrid(const std::vector<cv::KeyPoint>& keypoints, cv::Size 
 }
 
 int KeypointGrid::CellX(float u) const {
-  if (!(u >= 0.f)) return 0;  // also NaN
-  return std::min(cols_ - 1, static_cast<int>(u / cell_size_));
+  const float c = u / static_cast<float>(cell_size_);
+  if (!(c >= 0.f)) return 0;  // also NaN
+  return c >= static_cast<float>(cols_ - 1) ? cols_ - 1 : static_cast<int>(c);
 }
 
 int KeypointGrid::CellY(float v) const {
-  if (!(v >= 0.f)) return 0;
-  return std::min(rows_ - 1, static_cast<int>(v / cell_size_));
+  const float c = v / static_cast<float>(cell_size_);
+  if (!(c >= 0.f)) return 0;
+  return c >= static_cast<float>(rows_ - 1) ? rows_ - 1 : static_cast<int>(c);
 }
 
 std::vector<size_t> KeypointGrid::FeaturesInArea(float u, float v, float r, int min_level,
