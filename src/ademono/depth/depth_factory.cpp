@@ -4,16 +4,9 @@
 #include "ademono/depth/cache_depth.h"
 #include "ademono/depth/onnx_depth.h"
 #include "ademono/depth/sensor_depth.h"
+#include "ademono/depth/simulated_depth.h"
 
 namespace ademono {
-namespace {
-
-[[noreturn]] void ThrowNotAvailable(const std::string& kind) {
-  throw InputError("depth provider '" + kind + "' is not available in this build");
-}
-
-}  // namespace
-
 std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
                                                  const DepthFactoryContext& context) {
   const size_t colon = spec.find(':');
@@ -29,7 +22,7 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
     return std::make_unique<CacheDepthProvider>(argument);
   }
   // --- simulated[:k=v,...] (engineer "synth" adds this branch) ---
-  if (kind == "simulated") ThrowNotAvailable(kind);
+  if (kind == "simulated") return MakeSimulatedDepthProvider(argument, context);
   // --- model:FILE.onnx[,spec=Y.yaml] (engineer "onnx" adds this branch) ---
   if (kind == "model") return MakeOnnxDepthProvider(argument, context);
 

@@ -1,0 +1,63 @@
+#pragma once
+// A SIMULATION of a monocular depth network, not a network: it degrades ground-truth depth (the
+// dataset's own depth in FrameData, or a cache folder given as gt=DIR) with the error patterns
+// learned metric depth shows, so the SLAM pipeline can be tested against known truth:
+//   z_out = scale * (z_edge + sigma(z) * n),   sigma(z) = a * z + b * z^2
+// - scale: global scale bias (a network's metric scale is never exact);
+// - n: unit-variance noise, 70 % of the variance a smooth low-frequency field (errors of nearby
+//   pixels are correlated, as a network's are) and 30 % per-pixel noise;
+// - z_edge: ground truth with depth edges smeared: within `edge_blur` pixels of a depth
+//   discontinuity (local max/min > 1.1) the depth is the local mean of valid depths;
+// - a fraction `invalid` of the pixels (and every pixel without ground truth) is 0.
+// Deterministic per frame: the noise is drawn from (seed, frame index) only.
+//
+// Spec: simulated[:scale=1.05,a=0.01,b=0.001,edge_blur=3,invalid=0.02,seed=S,gt=DIR]
+// (every key optional; seed defaults to the run's seed).
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "ademono/depth/depth_factory.h"
+#include "ademono/depth/depth_provider.h"
+
+namespace ademono {
+
+struct SimulatedDepthOptions {
+  double scale = 1.05;
+  double a = 0.01;    // relative noise (sigma grows linearly with depth)
+  double b = 0.001;   // 1/m: quadratic growth, dominating far away
+  int edge_blur = 3;  // pixels; 0 keeps edges sharp
+  double invalid = 0.02;
+  uint64_t seed = 0;
+  std::optional<std::filesystem::path> gt_dir;  // ground truth from a depth cache folder
+
+  // Throws std::invalid_argument naming the first bad field.
+  void Check() const;
+  // Parses "k=v,k=v" (empty: defaults). InputError for unknown keys or bad values.
+  static SimulatedDepthOptions Parse(const std::string& argument, uint64_t default_seed);
+};
+
+class SimulatedDepthProvider : public DepthProvider {
+ public:
+  // `ground_truth`: where true depth comes from; null uses FrameData::depth.
+  SimulatedDepthProvider(const SimulatedDepthOptions& options,
+                         std::unique_ptr<DepthProvider> ground_truth);
+  std::string Name() const override { return "simulated"; }
+  // InputError naming the frame when it has no ground-truth depth or it has the wrong size.
+  cv::Mat Depth(const FrameData& frame, const Camera& camera) override;
+  // The degradation alone, for a given ground truth (CV_32FC1 metres) and frame index.
+  cv::Mat Degrade(const cv::Mat& depth_m, size_t frame_index) const;
+
+ private:
+  SimulatedDepthOptions options_;
+  std::unique_ptr<DepthProvider> ground_truth_;
+};
+
+// The `simulated` branch of MakeDepthProvider: `argument` is what follows "simulated:".
+std::unique_ptr<DepthProvider> MakeSimulatedDepthProvider(const std::string& argument,
+                                                          const DepthFactoryContext& context);
+
+}  // namespace ademono
