@@ -10,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <regex>
 
 #include "ademono/core/error.h"
@@ -74,7 +75,7 @@ int RunInfer(const InferArgs& args) {
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
   auto sequence = ademono::OpenSequence(args.dataset, camera_yaml);
-  size_t start = 0, end = sequence->Size();
+  size_t start = 0, end = std::numeric_limits<size_t>::max();
   if (!args.frames.empty()) ParseFrames(args.frames, &start, &end);
   if (start >= sequence->Size()) {
     throw ademono::InputError(fmt::format("--frames '{}': the sequence has only {} frames",
