@@ -169,7 +169,7 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
     for (int side : {-1, 1}) {
       scene.static_boxes.push_back(MakeBox(
           At(x + segment / 2, 9.0 * side, 0.075), {segment / 2, 2.0, 0.075},
-          textures.Make(TextureStyle::kSidewalk, segment, segment, 0.02, {0.85f, 0.9f, 0.95f})));
+          textures.Make(TextureStyle::kSidewalk, segment, 4.0, 0.02, {0.85f, 0.9f, 0.95f})));
     }
   }
   // Open ground (lawns, yards) behind the sidewalks, under and between the buildings.
@@ -177,7 +177,7 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
     for (int side : {-1, 1}) {
       scene.static_boxes.push_back(MakeBox(
           At(x + segment, 36.0 * side, -0.05), {segment, 25.0, 0.05},
-          textures.Make(TextureStyle::kFloor, 2 * segment, 50.0, 0.04, {0.45f, 0.8f, 0.55f})));
+          textures.Make(TextureStyle::kFloor, 2 * segment, 50.0, 0.05, {0.45f, 0.8f, 0.55f})));
     }
   }
   // Buildings along both sides; facades 11 to 40 m to the side.
