@@ -44,7 +44,7 @@ struct RunArgs {
   std::string depth = "sensor";
   std::string detector = "none";
   std::string frames;
-  std::string seed = "42";
+  std::string seed;  // empty: the config's filter.seed
   bool no_enhancement = false;
   bool no_dynamic_removal = false;
   bool no_distant_filter = false;
@@ -196,7 +196,7 @@ int Run(const RunArgs& args) {
   } catch (const std::exception& e) {
     ThrowInputError(config_path, std::string("detector: ") + e.what());
   }
-  options.filter.seed = ParseSeed(args.seed);
+  if (!args.seed.empty()) options.filter.seed = ParseSeed(args.seed);
   if (args.no_enhancement) options.filter.enable_enhancement = false;
   if (args.no_dynamic_removal) options.filter.enable_dynamic_removal = false;
   if (args.no_distant_filter) options.filter.enable_distant_filter = false;
@@ -311,7 +311,7 @@ const bool kRegistered = RegisterCommand(
       app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
           ->capture_default_str();
       app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
-      app.add_option("--seed", args->seed, "random seed of the distant filter: N or 'time'")->capture_default_str();
+      app.add_option("--seed", args->seed, "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
       app.add_flag("--no-enhancement", args->no_enhancement, "disable depth-weighted feature enhancement");
       app.add_flag("--no-dynamic-removal", args->no_dynamic_removal, "disable dynamic interference removal");
       app.add_flag("--no-distant-filter", args->no_distant_filter, "disable distant-point filtering");

@@ -71,6 +71,7 @@ void TrackingOptions::Check() const {
   Require(keyframe_ref_ratio > 0 && keyframe_ref_ratio <= 1, "tracking: keyframe_ref_ratio in (0, 1]");
   Require(close_tracked_min >= 0 && close_untracked_min >= 0 && new_keyframe_min_points >= 0,
           "tracking: close point counts must be >= 0");
+  Require(keyframe_ref_min_observations >= 0, "tracking: keyframe_ref_min_observations must be >= 0");
   Require(relocalisation_keyframes > 0, "tracking: relocalisation_keyframes must be > 0");
   Require(reinit_after_lost_frames >= 0, "tracking: reinit_after_lost_frames must be >= 0");
   Require(dynamic_cull_hits > 0, "tracking: dynamic_cull_hits must be > 0");
@@ -81,7 +82,7 @@ TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
                  {"min_init_points", "motion_search_radius", "min_motion_matches",
                   "local_search_radius", "min_inliers", "min_inliers_after_reloc",
                   "max_local_keyframes", "min_frames_between_keyframes",
-                  "max_frames_between_keyframes", "keyframe_ref_ratio", "close_tracked_min",
+                  "max_frames_between_keyframes", "keyframe_ref_ratio", "keyframe_ref_min_observations", "close_tracked_min",
                   "close_untracked_min", "new_keyframe_min_points", "relocalisation_keyframes",
                   "reinit_after_lost_frames", "dynamic_cull_hits"});
   TrackingOptions o;
@@ -95,6 +96,7 @@ TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
   Read(node, "min_frames_between_keyframes", o.min_frames_between_keyframes);
   Read(node, "max_frames_between_keyframes", o.max_frames_between_keyframes);
   Read(node, "keyframe_ref_ratio", o.keyframe_ref_ratio);
+  Read(node, "keyframe_ref_min_observations", o.keyframe_ref_min_observations);
   Read(node, "close_tracked_min", o.close_tracked_min);
   Read(node, "close_untracked_min", o.close_untracked_min);
   Read(node, "new_keyframe_min_points", o.new_keyframe_min_points);

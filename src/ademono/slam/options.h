@@ -45,6 +45,8 @@ struct TrackingOptions {
   int min_frames_between_keyframes = 0;
   int max_frames_between_keyframes = 30;  // about one second at 30 Hz
   double keyframe_ref_ratio = 0.75;   // tracked/reference-keyframe point ratio for a new keyframe
+  // Reference-keyframe points count when seen by this many keyframes (0: ORB-SLAM's 2 or 3).
+  int keyframe_ref_min_observations = 0;
   int close_tracked_min = 100;        // fewer tracked close points than this ...
   int close_untracked_min = 70;       // ... and more untracked ones: new keyframe
   int new_keyframe_min_points = 100;  // map points created from a new keyframe's depth at least

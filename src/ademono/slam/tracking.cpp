@@ -5,6 +5,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <spdlog/spdlog.h>
 
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
@@ -321,7 +322,8 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
     return false;
   }
   if (reference_keyframe_ == nullptr) return true;
-  const int min_obs = map_.NumKeyFrames() <= 2 ? 2 : 3;
+  const int min_obs = t.keyframe_ref_min_observations > 0 ? t.keyframe_ref_min_observations
+                      : map_.NumKeyFrames() <= 2 ? 2 : 3;
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
 
@@ -342,6 +344,9 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const bool c1b = since_kf >= static_cast<uint64_t>(t.min_frames_between_keyframes) && idle;
   const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
+  spdlog::debug("frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
+                frame.index, matches_inliers_, ref_matches, tracked_close, untracked_close,
+                local_points_.size(), local_keyframes_.size());
   if (!((c1a || c1b || c1c) && c2)) return false;
   // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
   return idle || local_mapping_.QueueSize() < 3;

@@ -1,0 +1,92 @@
+#include "ademono/optimize/bundle_adjustment.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace ademono {
+namespace {
+
+constexpr PinholeIntrinsics kIntrinsics{585, 585, 320, 240, 585 * 0.08};
+
+// Three cameras stepping along x looking at points 2-4 m ahead; the first camera is fixed.
+BundleAdjustmentProblem MakeProblem(std::mt19937& rng, std::vector<Rigid3d>* true_poses,
+                                    std::vector<Eigen::Vector3d>* true_points) {
+  BundleAdjustmentProblem problem;
+  problem.intrinsics = kIntrinsics;
+  for (int c = 0; c < 3; ++c) {
+    Rigid3d world_from_cam = Rigid3d::Identity();
+    world_from_cam.translation() = Eigen::Vector3d(0.1 * c, 0.02 * c, 0);
+    true_poses->push_back(world_from_cam.inverse());
+  }
+  std::uniform_real_distribution<double> xy(-1, 1), z(2, 4);
+  std::normal_distribution<double> pixel_noise(0, 0.3), point_noise(0, 0.03), pose_noise(0, 0.01);
+  for (int p = 0; p < 150; ++p) true_points->emplace_back(xy(rng), xy(rng), z(rng));
+  for (int c = 0; c < 3; ++c) {
+    Rigid3d start = (*true_poses)[c];
+    if (c > 0) start.translation() += Eigen::Vector3d(pose_noise(rng), pose_noise(rng), pose_noise(rng));
+    problem.cameras.push_back({start, c == 0});
+  }
+  for (const auto& x : *true_points) {
+    problem.points.push_back(x + Eigen::Vector3d(point_noise(rng), point_noise(rng), point_noise(rng)));
+  }
+  for (size_t p = 0; p < true_points->size(); ++p) {
+    for (size_t c = 0; c < 3; ++c) {
+      const Eigen::Vector3d pc = (*true_poses)[c] * (*true_points)[p];
+      ImageObservation o;
+      const double u = kIntrinsics.fx * pc.x() / pc.z() + kIntrinsics.cx;
+      o.pixel = Eigen::Vector2d(u + pixel_noise(rng), kIntrinsics.fy * pc.y() / pc.z() + kIntrinsics.cy + pixel_noise(rng));
+      if (p % 2 == 0) o.u_right = u - kIntrinsics.bf / pc.z() + pixel_noise(rng);
+      problem.observations.push_back({c, p, o});
+    }
+  }
+  return problem;
+}
+
+TEST(BundleAdjustmentTest, RefinesPosesAndPointsAndKeepsFixedCamera) {
+  std::mt19937 rng(7);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  const BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  const BundleAdjustmentResult result = SolveBundleAdjustment(problem);
+  EXPECT_TRUE(result.cam_from_world[0].matrix() == problem.cameras[0].cam_from_world.matrix());
+  for (int c = 1; c < 3; ++c) {
+    EXPECT_LT((result.cam_from_world[c].translation() - poses[c].translation()).norm(), 0.005) << c;
+  }
+  double before = 0, after = 0;
+  for (size_t p = 0; p < points.size(); ++p) {
+    before += (problem.points[p] - points[p]).norm();
+    after += (result.points[p] - points[p]).norm();
+  }
+  EXPECT_LT(after, 0.7 * before);
+  int outliers = 0;
+  for (bool o : result.outlier) outliers += o ? 1 : 0;
+  EXPECT_LT(outliers, 10);
+}
+
+TEST(BundleAdjustmentTest, MarksCorruptedObservationsAsOutliers) {
+  std::mt19937 rng(8);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  problem.observations[10].image.pixel += Eigen::Vector2d(50, 50);
+  const BundleAdjustmentResult result = SolveBundleAdjustment(problem);
+  EXPECT_TRUE(result.outlier[10]);
+}
+
+TEST(BundleAdjustmentTest, DeterministicAndValidatesIndices) {
+  std::mt19937 rng(9);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  const auto a = SolveBundleAdjustment(problem);
+  const auto b = SolveBundleAdjustment(problem);
+  for (size_t c = 0; c < a.cam_from_world.size(); ++c) {
+    EXPECT_TRUE(a.cam_from_world[c].matrix() == b.cam_from_world[c].matrix());
+  }
+  problem.observations[0].point = 100000;
+  EXPECT_THROW(SolveBundleAdjustment(problem), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ademono

@@ -1,0 +1,128 @@
+#include "ademono/slam/system.h"
+
+#include <gtest/gtest.h>
+
+#include "ademono/core/error.h"
+#include "ademono/depth/depth_factory.h"
+#include "ademono/slam/pipeline.h"
+#include "slam_test_util.h"
+
+namespace ademono {
+namespace {
+
+using testing_util::Fault;
+using testing_util::Slice;
+
+SystemOptions TestOptions() {
+  SystemOptions options;
+  options.depth.min_depth = 0.3;
+  options.depth.max_depth = 6.0;
+  return options;
+}
+
+Trajectory RunSlice(const Sequence& sequence, const SystemOptions& options, bool overlap,
+                    std::vector<TrackResult>* results = nullptr) {
+  DepthFactoryContext context;
+  context.sequence = &sequence;
+  auto depth = MakeDepthProvider("sensor", context);
+  System system(sequence.GetCamera(), options);
+  PipelineOptions pipeline;
+  pipeline.overlap = overlap;
+  pipeline.on_frame = [&](const FrameData&, const cv::Mat&, const std::vector<Detection>&, const TrackResult& r) {
+    if (results != nullptr) results->push_back(r);
+  };
+  RunPipeline(sequence, depth.get(), nullptr, system, pipeline);
+  system.Shutdown();
+  return system.FrameTrajectory();
+}
+
+// Largest position error of the estimate against the ground truth expressed in the first
+// frame's camera (the SLAM world is the first camera).
+double MaxPositionError(const Sequence& sequence, const Trajectory& trajectory) {
+  const Rigid3d first_from_world = sequence.Load(0).world_from_cam_gt->inverse();
+  double worst = 0;
+  for (const StampedPose& p : trajectory) {
+    const size_t i = static_cast<size_t>(std::lround(p.timestamp * 30.0));
+    const Rigid3d gt = first_from_world * *sequence.Load(i).world_from_cam_gt;
+    worst = std::max(worst, (gt.translation() - p.world_from_cam.translation()).norm());
+  }
+  return worst;
+}
+
+TEST(SystemTest, TracksAShortSliceAccurately) {
+  const auto sequence = Slice(0, 40);
+  std::vector<TrackResult> results;
+  const Trajectory trajectory = RunSlice(*sequence, TestOptions(), true, &results);
+  ASSERT_EQ(trajectory.size(), 40u);
+  EXPECT_LT(MaxPositionError(*sequence, trajectory), 0.03);
+  EXPECT_TRUE(results.front().new_keyframe);
+  for (const TrackResult& r : results) EXPECT_GT(r.num_kept, 300);
+}
+
+TEST(SystemTest, SurvivesNoDepthBlackAndDuplicatedFrames) {
+  // 60 frames: frame 15 without depth, frame 30 black, frame 44 twice.
+  const auto sequence = Slice(0, 60, {{15, Fault::kNoDepth}, {30, Fault::kBlack}}, {44});
+  std::vector<TrackResult> results;
+  const Trajectory trajectory = RunSlice(*sequence, TestOptions(), true, &results);
+  ASSERT_EQ(results.size(), 61u);
+  EXPECT_FALSE(results[30].tracked);      // nothing to track in a black frame
+  EXPECT_EQ(results[30].num_keypoints, 0);
+  EXPECT_TRUE(results[15].tracked);       // 2-dof residuals only
+  for (size_t i = 32; i < results.size(); ++i) EXPECT_TRUE(results[i].tracked) << "frame " << i;
+  EXPECT_GE(trajectory.size(), 59u);
+  EXPECT_LT(MaxPositionError(*sequence, trajectory), 0.05);
+}
+
+TEST(SystemTest, RepeatedRunsAndPrefetchGiveIdenticalTrajectories) {
+  const auto sequence = Slice(100, 145);
+  const Trajectory a = RunSlice(*sequence, TestOptions(), true);
+  const Trajectory b = RunSlice(*sequence, TestOptions(), true);
+  const Trajectory sequential = RunSlice(*sequence, TestOptions(), false);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), sequential.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+    EXPECT_TRUE(a[i].world_from_cam.matrix() == sequential[i].world_from_cam.matrix()) << i;
+  }
+}
+
+TEST(SystemTest, KeypointDepthsRejectInvalidAndEdgeReadings) {
+  cv::Mat depth(20, 20, CV_32FC1, cv::Scalar(2.0f));
+  depth(cv::Rect(10, 0, 10, 20)).setTo(3.0f);  // a step edge at x = 10
+  depth.at<float>(5, 3) = 0.f;                 // a hole
+  FrameDepthOptions options;
+  const std::vector<cv::KeyPoint> keypoints{{cv::Point2f(4, 10), 1}, {cv::Point2f(9, 10), 1},
+                                            {cv::Point2f(3, 6), 1},  {cv::Point2f(50, 10), 1}};
+  const std::vector<float> d = System::KeypointDepths(keypoints, depth, options);
+  EXPECT_FLOAT_EQ(d[0], 2.0f);
+  EXPECT_LT(d[1], 0);  // next to the edge
+  EXPECT_LT(d[2], 0);  // next to the hole
+  EXPECT_LT(d[3], 0);  // outside the image
+  options.edge_radius = 0;
+  EXPECT_FLOAT_EQ(System::KeypointDepths(keypoints, depth, options)[1], 2.0f);
+  EXPECT_TRUE(System::KeypointDepths(keypoints, cv::Mat(), options)[0] < 0);
+}
+
+TEST(SystemOptionsTest, YamlErrorsNameTheFile) {
+  const std::filesystem::path path = "/configs/bad.yaml";
+  auto expect_error = [&](const std::string& text, const std::string& needle) {
+    try {
+      SystemOptions::FromYaml(YAML::Load(text), path);
+      FAIL() << "expected InputError for " << text;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+    }
+  };
+  expect_error("tracking:\n  min_inliers: many\n", "min_inliers");
+  expect_error("tracking:\n  bogus_key: 1\n", "bogus_key");
+  expect_error("depth:\n  min_depth: 5\n  max_depth: 1\n", "min_depth");
+  expect_error("nonsense_section: {}\n", "nonsense_section");
+  const SystemOptions ok = SystemOptions::FromYaml(YAML::Load("tracking:\n  min_inliers: 40\n"), path);
+  EXPECT_EQ(ok.tracking.min_inliers, 40);
+  EXPECT_EQ(ok.tracking.min_init_points, TrackingOptions().min_init_points);
+}
+
+}  // namespace
+}  // namespace ademono
