@@ -33,11 +33,20 @@ cv::Mat Grey(int width, int height, int value) {
 }
 
 // Writes `text` as a spec YAML into a fresh temp file and returns its path.
-fs::path WriteSpec(const std::string& name, const std::string& text) {
-  const fs::path dir =
+// One temp folder per test process, removed at exit.
+struct TempDir {
+  fs::path path =
       fs::temp_directory_path() / ("ademono_onnx_depth_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const fs::path path = dir / (name + ".yaml");
+  TempDir() { fs::create_directories(path); }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+fs::path WriteSpec(const std::string& name, const std::string& text) {
+  static const TempDir dir;
+  const fs::path path = dir.path / (name + ".yaml");
   std::ofstream(path) << text;
   return path;
 }
