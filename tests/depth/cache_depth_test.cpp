@@ -18,7 +18,9 @@ namespace fs = std::filesystem;
 class CacheDepthTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("ademono_cache_depth_" + std::to_string(::getpid()));
+    std::string name = "ademono_cache_depth_";
+    name += std::to_string(::getpid());
+    dir_ = fs::temp_directory_path() / name;
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -72,16 +74,16 @@ TEST_F(CacheDepthTest, RejectsEmptyFolderAndBadFiles) {
   EXPECT_THROW(CacheDepthProvider provider(dir_), InputError);
   EXPECT_THROW(CacheDepthProvider provider(dir_ / "missing"), InputError);
   cv::Mat rgb(2, 2, CV_8UC3, cv::Scalar::all(1));
-  ASSERT_TRUE(cv::imwrite((dir_ / "a.png").string(), rgb));
+  ASSERT_TRUE(cv::imwrite((dir_ / "image_a.png").string(), rgb));
   CacheDepthProvider provider(dir_);
   FrameData frame;
-  frame.name = "a";
+  frame.name = "image_a";
   EXPECT_THROW(provider.Depth(frame, Camera{}), InputError);  // three channels
   {
-    std::ofstream(dir_ / "b.png") << "not an image";
+    std::ofstream(dir_ / "image_b.png") << "not an image";
   }
   CacheDepthProvider provider2(dir_);
-  frame.name = "b";
+  frame.name = "image_b";
   EXPECT_THROW(provider2.Depth(frame, Camera{}), InputError);
 }
 
