@@ -108,6 +108,63 @@ TEST_F(GeneratorTest, RoundTripsThroughTumReader) {
   }
 }
 
+// Static scene points seen in one frame land, through the ground-truth poses read back from
+// groundtruth.txt, on pixels of a later frame whose depth is theirs: poses, depth and camera
+// agree (up to the 0.2 mm PNG step and one-pixel rounding at depth edges).
+TEST_F(GeneratorTest, GroundTruthPosesReprojectDepthAcrossFrames) {
+  GeneratorOptions options = SmallOffice(5);
+  options.scene.persons = 1;
+  options.scene.frames = 16;
+  options.scene.width = 160, options.scene.height = 120;
+  options.scene.motion = MotionKind::kXyz;
+  const fs::path dir = root_ / "office";
+  GenerateSequence(options, dir);
+  const auto sequence = OpenSequence("tum:" + dir.string());
+  const Trajectory groundtruth = ReadTumTrajectory(dir / "groundtruth.txt");
+  const Camera& camera = sequence->GetCamera();
+  const FrameData first = sequence->Load(0), last = sequence->Load(15);
+  const cv::Mat mask0 = cv::imread((dir / "masks" / "0.000000.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat mask1 = cv::imread((dir / "masks" / "0.500000.png").string(), cv::IMREAD_UNCHANGED);
+  const Rigid3d last_from_first =
+      groundtruth[15].world_from_cam.inverse() * groundtruth[0].world_from_cam;
+  EXPECT_GT(last_from_first.translation().norm(), 0.05) << "the camera moved";
+  std::vector<double> errors;
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const float z = first.depth.at<float>(v, u);
+      if (z <= 0.f || mask0.at<uint8_t>(v, u)) continue;
+      const Eigen::Vector3d p = last_from_first * camera.Unproject({u, v}, z);
+      const Eigen::Vector2d px = camera.ProjectUndistorted(p);
+      const int u0 = static_cast<int>(std::floor(px.x())),
+                v0 = static_cast<int>(std::floor(px.y()));
+      if (u0 < 0 || v0 < 0 || u0 + 1 >= camera.width || v0 + 1 >= camera.height) continue;
+      // Inverse depth is affine in pixel coordinates on a plane: interpolate it bilinearly
+      // inside planar patches (the four neighbours agree within 2 %), skipping depth edges and
+      // pixels of walking persons.
+      double inverse[2][2], lo = 1e9, hi = 0;
+      bool usable = true;
+      for (int dv = 0; dv < 2; ++dv)
+        for (int du = 0; du < 2; ++du) {
+          const float d = last.depth.at<float>(v0 + dv, u0 + du);
+          usable &= d > 0.f && !mask1.at<uint8_t>(v0 + dv, u0 + du);
+          lo = std::min<double>(lo, d), hi = std::max<double>(hi, d);
+          inverse[dv][du] = d > 0.f ? 1.0 / d : 0.0;
+        }
+      if (!usable || hi > 1.02 * lo) continue;
+      const double fu = px.x() - u0, fv = px.y() - v0;
+      const double inv = (1 - fv) * ((1 - fu) * inverse[0][0] + fu * inverse[0][1]) +
+                         fv * ((1 - fu) * inverse[1][0] + fu * inverse[1][1]);
+      errors.push_back(std::abs(1.0 / inv - p.z()));
+    }
+  }
+  ASSERT_GT(errors.size(), 10000u);
+  std::sort(errors.begin(), errors.end());
+  // The few percent left are occlusion boundaries (points hidden by furniture in the later
+  // frame), so the bound is on the 95th percentile.
+  EXPECT_LT(errors[errors.size() / 2], 0.0003);
+  EXPECT_LT(errors[errors.size() * 95 / 100], 0.001);
+}
+
 // Masks are exactly the pixels of moving objects; every ground-truth box is the tight bound of
 // its object's visible pixels; every mask pixel lies in a box of a moving object; the static
 // mannequin has boxes but is never in the mask.
