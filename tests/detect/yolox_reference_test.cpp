@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <thread>
 
 #include "ademono/core/file_util.h"
 #include "ademono/detect/yolo_detector.h"
@@ -55,6 +56,39 @@ TEST(YoloxReferenceTest, ReproducesExpectedDetections) {
       EXPECT_GE(best_iou, 0.9f) << w.dump();
       EXPECT_NEAR(detections[best].score, w["score"].get<float>(), 0.02f) << w.dump();
       EXPECT_EQ(detections[best].class_name, w["class"].get<std::string>());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ademono
+
+namespace ademono {
+namespace {
+
+// Detect() is documented as deterministic and safe from worker threads: two threads sharing one
+// detector must get exactly the single-threaded result.
+TEST(YoloxReferenceTest, ConcurrentCallsGiveIdenticalResults) {
+  const auto model = kShared / "models/yolox_nano.onnx";
+  if (!std::filesystem::exists(model)) GTEST_SKIP() << "no " << model;
+  DetectorOptions options;
+  options.class_ids.clear();
+  YoloDetector detector(model, YoloArch::kAuto, options);
+  const cv::Mat image = ReadImage(kShared / "images/street.png", cv::IMREAD_COLOR);
+  const auto reference = detector.DetectImage(image);
+  ASSERT_FALSE(reference.empty());
+  std::vector<std::vector<Detection>> results(2);
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < results.size(); ++t) {
+    threads.emplace_back([&, t] { results[t] = detector.DetectImage(image); });
+  }
+  for (auto& thread : threads) thread.join();
+  for (const auto& result : results) {
+    ASSERT_EQ(result.size(), reference.size());
+    for (size_t i = 0; i < result.size(); ++i) {
+      EXPECT_EQ(result[i].class_id, reference[i].class_id);
+      EXPECT_EQ(result[i].score, reference[i].score);
+      EXPECT_EQ(result[i].box, reference[i].box);
     }
   }
 }
