@@ -21,6 +21,7 @@
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
 #include "ademono/depth/depth_factory.h"
+#include "ademono/eval/trajectory_eval.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
@@ -28,10 +29,6 @@
 #include "ademono/slam/system.h"
 #include "command.h"
 
-#if __has_include("ademono/eval/ate.h")
-#include "ademono/eval/ate.h"
-#define ADEMONO_HAVE_EVAL_ATE 1
-#endif
 
 namespace fs = std::filesystem;
 
@@ -166,6 +163,37 @@ nlohmann::json TimingJson(const std::vector<double>& values) {
   return {{"median_ms", Percentile(values, 0.5)}, {"p95_ms", Percentile(values, 0.95)}};
 }
 
+// ATE (se3 and sim3 alignment) and RPE over one second of frames against the dataset's ground
+// truth, with the evaluation module (the same numbers `ademono eval` prints).
+nlohmann::json AccuracyJson(const std::vector<FrameData>& frames, const Trajectory& estimate) {
+  Trajectory gt;
+  for (const FrameData& f : frames) {
+    if (f.world_from_cam_gt) gt.push_back({f.timestamp, *f.world_from_cam_gt});
+  }
+  if (gt.size() < 3 || estimate.size() < 3) return nullptr;
+  nlohmann::json json;
+  try {
+    EvalOptions options;
+    options.alignment = Alignment::kSe3;
+    const EvalResult se3 = EvaluateTrajectories(gt, estimate, options);
+    options.alignment = Alignment::kSim3;
+    const EvalResult sim3 = EvaluateTrajectories(gt, estimate, options);
+    options.alignment = Alignment::kSe3;
+    options.rpe_delta = 30;
+    const EvalResult rpe = EvaluateTrajectories(gt, estimate, options);
+    json["matched_poses"] = se3.matched_poses;
+    json["ate_se3_rmse_m"] = se3.ape.rmse;
+    json["ate_sim3_rmse_m"] = sim3.ape.rmse;
+    json["sim3_scale"] = sim3.gt_from_est.scale;
+    json["rpe_30_frames_trans_rmse_m"] = rpe.rpe_trans.rmse;
+    json["rpe_30_frames_rot_rmse_deg"] = rpe.rpe_rot_deg.rmse;
+  } catch (const std::exception& e) {
+    spdlog::warn("accuracy not computed: {}", e.what());
+    return nullptr;
+  }
+  return json;
+}
+
 int Run(const RunArgs& args) {
   if (args.out.empty()) throw InputError("--out is required");
   std::optional<fs::path> camera_yaml;
@@ -285,15 +313,20 @@ int Run(const RunArgs& args) {
   summary["timing"] = {{"extraction", TimingJson(extraction)}, {"depth", TimingJson(depth_ms)},
                        {"detection", TimingJson(detection)},   {"filter", TimingJson(filter)},
                        {"tracking", TimingJson(tracking)},     {"local_mapping", TimingJson(mapping)}};
-#ifdef ADEMONO_HAVE_EVAL_ATE
-  if (sequence->HasGroundTruth()) summary["ate"] = AteSummaryJson(trajectory, result.ground_truth_frames);
-#endif
+  if (sequence->HasGroundTruth()) {
+    const nlohmann::json accuracy = AccuracyJson(result.ground_truth_frames, trajectory);
+    if (!accuracy.is_null()) summary["accuracy"] = accuracy;
+  }
   WriteTextFileAtomic(out / "summary.json", summary.dump(2) + "\n");
 
   std::cout << "tracked " << trajectory.size() << "/" << result.frames << " frames (lost " << system.NumLost()
             << "), " << system.NumKeyFrames() << " keyframes, " << system.NumMapPoints()
             << " map points; tracking median " << std::fixed << std::setprecision(1)
             << Percentile(tracking, 0.5) << " ms/frame\n";
+  if (summary.contains("accuracy")) {
+    std::cout << "ATE se3 " << std::setprecision(4) << summary["accuracy"]["ate_se3_rmse_m"].get<double>()
+              << " m, sim3 " << summary["accuracy"]["ate_sim3_rmse_m"].get<double>() << " m\n";
+  }
   if (trajectory.size() < result.frames) {
     std::cout << (result.frames - trajectory.size()) << " frames untracked (no pose written)\n";
   }
