@@ -1,9 +1,12 @@
 #include "ademono/depth/simulated_depth.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <vector>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
@@ -32,10 +35,9 @@ double ParseNumber(const std::string& key, const std::string& value) {
   return out;
 }
 
-// Zero-mean, unit-variance smooth field: Gaussian values on a coarse grid (one per ~32 px),
+// Zero-mean, unit-variance smooth field: Gaussian values on a coarse grid (one per `cell` px),
 // cubic upsampling, normalised by its own spread.
-cv::Mat SmoothField(cv::Size size, cv::RNG& rng) {
-  const int cell = 32;
+cv::Mat SmoothField(cv::Size size, cv::RNG& rng, int cell) {
   cv::Mat coarse(size.height / cell + 3, size.width / cell + 3, CV_32F);
   rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
   cv::Mat field;
@@ -166,11 +168,21 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
 
   // Noise drawn from (seed, frame) only: same frame, same maps, whatever the thread.
   cv::RNG rng(Mix64(options_.seed ^ Mix64(frame_index + 0x51D)) | 1);
-  const cv::Mat smooth = SmoothField(size, rng);
+  const cv::Mat smooth = SmoothField(size, rng, 32);
   cv::Mat pixel(size, CV_32F);
   rng.fill(pixel, cv::RNG::NORMAL, 0.0, 1.0);
-  cv::Mat drop(size, CV_32F);
-  rng.fill(drop, cv::RNG::UNIFORM, 0.0, 1.0);
+  // Invalid pixels come in blobs (where a network's confidence is low), not as salt noise:
+  // the top `invalid` fraction of another smooth field.
+  const cv::Mat holes = SmoothField(size, rng, 12);
+  float hole_threshold = std::numeric_limits<float>::infinity();
+  if (options_.invalid > 0.0) {
+    std::vector<float> values(holes.begin<float>(), holes.end<float>());
+    const size_t k =
+        std::min(values.size() - 1,
+                 static_cast<size_t>(std::floor((1.0 - options_.invalid) * values.size())));
+    std::nth_element(values.begin(), values.begin() + k, values.end());
+    hole_threshold = values[k];
+  }
 
   const float smooth_weight = std::sqrt(0.7f), pixel_weight = std::sqrt(0.3f);
   cv::Mat out(size, CV_32F);
@@ -179,11 +191,11 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
     const float* z_edge = edged.ptr<float>(v);
     const float* ns = smooth.ptr<float>(v);
     const float* np = pixel.ptr<float>(v);
-    const float* d = drop.ptr<float>(v);
+    const float* hole = holes.ptr<float>(v);
     float* o = out.ptr<float>(v);
     for (int u = 0; u < size.width; ++u) {
       const double z = z_true[u];
-      if (!(z > 0.0) || d[u] < options_.invalid) {
+      if (!(z > 0.0) || hole[u] >= hole_threshold) {
         o[u] = 0.f;
         continue;
       }

@@ -8,7 +8,8 @@
 //   pixels are correlated, as a network's are) and 30 % per-pixel noise;
 // - z_edge: ground truth with depth edges smeared: within `edge_blur` pixels of a depth
 //   discontinuity (local max/min > 1.1) the depth is the local mean of valid depths;
-// - a fraction `invalid` of the pixels (and every pixel without ground truth) is 0.
+// - a fraction `invalid` of the pixels, in blobs (the top of another smooth field, ~12 px
+//   correlation), and every pixel without ground truth is 0.
 // Deterministic per frame: the noise is drawn from (seed, frame index) only.
 //
 // Spec: simulated[:scale=1.05,a=0.01,b=0.001,edge_blur=3,invalid=0.02,seed=S,gt=DIR]
