@@ -47,6 +47,15 @@ TEST(PreprocessTest, TopLeftAndCentredPadding) {
   EXPECT_DOUBLE_EQ(back.y, 10.0);
 }
 
+TEST(PreprocessTest, GreyImagesBecomeThreeChannels) {
+  const cv::Mat grey(4, 4, CV_8UC1, cv::Scalar(7));
+  const cv::Mat out = ResizeAndPad(grey, {4, 4}, {4, 6}, PadPlacement::kTopLeft,
+                                   cv::Scalar::all(0), cv::INTER_LINEAR, nullptr);
+  EXPECT_EQ(out.type(), CV_8UC3);
+  EXPECT_EQ(out.at<cv::Vec3b>(3, 3), cv::Vec3b(7, 7, 7));
+  EXPECT_EQ(out.at<cv::Vec3b>(5, 3), cv::Vec3b(0, 0, 0));
+}
+
 TEST(PreprocessTest, BlobIsPlanarNormalisedAndOrdered) {
   cv::Mat image(1, 2, CV_8UC3);
   image.at<cv::Vec3b>(0, 0) = {10, 20, 30};  // B G R
