@@ -45,6 +45,10 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{drop_probability: 1.5}")),
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{z_th_m: far}")), std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{seed: -1}")), std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{enhancement_levels: 1.5}")),
+               std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("[1, 2]")), std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{enhancement_keep_ratio: 0}")),
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{dynamic_class_ids: person}")),
