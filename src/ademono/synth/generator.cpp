@@ -232,8 +232,10 @@ cv::Mat DepthToPng(const cv::Mat& depth_m) {
   return png;
 }
 
-GeneratorSummary GenerateSequence(const GeneratorOptions& options, const fs::path& out_dir,
-                                  const std::function<void(size_t, size_t)>& progress) {
+namespace {
+
+GeneratorSummary GenerateSequenceInto(const GeneratorOptions& options, const fs::path& out_dir,
+                                      const std::function<void(size_t, size_t)>& progress) {
   try {
     options.Check();
   } catch (const std::invalid_argument& e) {
@@ -313,6 +315,18 @@ GeneratorSummary GenerateSequence(const GeneratorOptions& options, const fs::pat
   summary.seconds_total =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
+}
+
+}  // namespace
+
+GeneratorSummary GenerateSequence(const GeneratorOptions& options, const fs::path& out_dir,
+                                  const std::function<void(size_t, size_t)>& progress) {
+  try {
+    return GenerateSequenceInto(options, out_dir, progress);
+  } catch (const fs::filesystem_error& e) {
+    // Disk full, permissions...: one line naming the path (the temporary folder is gone).
+    ThrowInputError(e.path1().empty() ? out_dir : e.path1(), e.code().message());
+  }
 }
 
 }  // namespace ademono::synth
