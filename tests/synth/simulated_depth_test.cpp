@@ -60,8 +60,17 @@ TEST(SimulatedDepth, ErrorsAreSpatiallyCorrelated) {
   cv::meanStdDev(right, mr, sr);
   const double covariance = cv::mean((left - ml[0]).mul(right - mr[0]))[0];
   const double correlation = covariance / (sl[0] * sr[0]);
-  EXPECT_GT(correlation, 0.6);  // 70 % of the variance is a smooth field
-  EXPECT_LT(correlation, 0.8);  // and 30 % per-pixel noise
+  EXPECT_GT(correlation, 0.8);   // 90 % of the variance is a smooth field
+  EXPECT_LT(correlation, 0.95);  // and 10 % per-pixel noise
+  // All per-pixel: no correlation.
+  options.pixel = 1.0;
+  const SimulatedDepthProvider white(options, nullptr);
+  const cv::Mat white_error = white.Degrade(Constant(4.0), 0) - 4.0;
+  const double white_correlation =
+      cv::mean(
+          white_error(cv::Rect(0, 0, 399, 300)).mul(white_error(cv::Rect(1, 0, 399, 300))))[0] /
+      cv::mean(white_error.mul(white_error))[0];
+  EXPECT_LT(std::abs(white_correlation), 0.02);
 }
 
 TEST(SimulatedDepth, InvalidFractionInBlobsAndMissingTruthStaysInvalid) {
@@ -138,7 +147,7 @@ TEST(SimulatedDepth, FactorySpecAndErrors) {
     return "";
   };
   EXPECT_EQ(message("simulated:foo=1"),
-            "depth provider 'simulated': unknown parameter 'foo' (expected scale, a, b, "
+            "depth provider 'simulated': unknown parameter 'foo' (expected scale, a, b, pixel, "
             "edge_blur, invalid, seed, gt)");
   EXPECT_EQ(message("simulated:scale=abc"),
             "depth provider 'simulated': 'scale=abc' is not a number");
@@ -146,6 +155,7 @@ TEST(SimulatedDepth, FactorySpecAndErrors) {
             "depth provider 'simulated': invalid must be in [0, 1)");
   EXPECT_EQ(message("simulated:edge_blur=2.5"),
             "depth provider 'simulated': 'edge_blur=2.5' must be a non-negative integer");
+  EXPECT_EQ(message("simulated:pixel=2"), "depth provider 'simulated': pixel must be in [0, 1]");
   EXPECT_EQ(message("simulated:scale"), "depth provider 'simulated': 'scale' is not key=value");
 
   FrameData no_depth;

@@ -56,6 +56,7 @@ void SimulatedDepthOptions::Check() const {
   if (!(b >= 0.0) || !std::isfinite(b)) throw std::invalid_argument("b must be >= 0");
   if (edge_blur < 0 || edge_blur > 50) throw std::invalid_argument("edge_blur must be in [0, 50]");
   if (!(invalid >= 0.0 && invalid < 1.0)) throw std::invalid_argument("invalid must be in [0, 1)");
+  if (!(pixel >= 0.0 && pixel <= 1.0)) throw std::invalid_argument("pixel must be in [0, 1]");
 }
 
 SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
@@ -80,6 +81,8 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.b = ParseNumber(key, value);
     } else if (key == "invalid") {
       options.invalid = ParseNumber(key, value);
+    } else if (key == "pixel") {
+      options.pixel = ParseNumber(key, value);
     } else if (key == "edge_blur" || key == "seed") {
       const double number = ParseNumber(key, value);
       if (number < 0 || number != std::floor(number) || number > 1.8e19)
@@ -96,7 +99,7 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.gt_dir = value;
     } else {
       BadSpec("unknown parameter '" + key +
-              "' (expected scale, a, b, edge_blur, invalid, seed, gt)");
+              "' (expected scale, a, b, pixel, edge_blur, invalid, seed, gt)");
     }
   }
   try {
@@ -184,7 +187,8 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
     hole_threshold = values[k];
   }
 
-  const float smooth_weight = std::sqrt(0.7f), pixel_weight = std::sqrt(0.3f);
+  const float smooth_weight = static_cast<float>(std::sqrt(1.0 - options_.pixel));
+  const float pixel_weight = static_cast<float>(std::sqrt(options_.pixel));
   cv::Mat out(size, CV_32F);
   for (int v = 0; v < size.height; ++v) {
     const float* z_true = truth.ptr<float>(v);

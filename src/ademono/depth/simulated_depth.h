@@ -4,15 +4,16 @@
 // learned metric depth shows, so the SLAM pipeline can be tested against known truth:
 //   z_out = scale * (z_edge + sigma(z) * n),   sigma(z) = a * z + b * z^2
 // - scale: global scale bias (a network's metric scale is never exact);
-// - n: unit-variance noise, 70 % of the variance a smooth low-frequency field (errors of nearby
-//   pixels are correlated, as a network's are) and 30 % per-pixel noise;
+// - n: unit-variance noise; a fraction `pixel` (default 10 %) of the variance is per-pixel noise,
+//   the rest a smooth low-frequency field (networks output smooth maps whose errors are
+//   correlated over tens of pixels);
 // - z_edge: ground truth with depth edges smeared: within `edge_blur` pixels of a depth
 //   discontinuity (local max/min > 1.1) the depth is the local mean of valid depths;
 // - a fraction `invalid` of the pixels, in blobs (the top of another smooth field, ~12 px
 //   correlation), and every pixel without ground truth is 0.
 // Deterministic per frame: the noise is drawn from (seed, frame index) only.
 //
-// Spec: simulated[:scale=1.05,a=0.01,b=0.001,edge_blur=3,invalid=0.02,seed=S,gt=DIR]
+// Spec: simulated[:scale=1.05,a=0.01,b=0.001,pixel=0.1,edge_blur=3,invalid=0.02,seed=S,gt=DIR]
 // (every key optional; seed defaults to the run's seed).
 
 #include <cstdint>
@@ -28,9 +29,10 @@ namespace ademono {
 
 struct SimulatedDepthOptions {
   double scale = 1.05;
-  double a = 0.01;    // relative noise (sigma grows linearly with depth)
-  double b = 0.001;   // 1/m: quadratic growth, dominating far away
-  int edge_blur = 3;  // pixels; 0 keeps edges sharp
+  double a = 0.01;     // relative noise (sigma grows linearly with depth)
+  double b = 0.001;    // 1/m: quadratic growth, dominating far away
+  double pixel = 0.1;  // share of the noise variance that is per-pixel (the rest is smooth)
+  int edge_blur = 3;   // pixels; 0 keeps edges sharp
   double invalid = 0.02;
   uint64_t seed = 0;
   std::optional<std::filesystem::path> gt_dir;  // ground truth from a depth cache folder
