@@ -7,11 +7,12 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <limits>
-#include <regex>
 
 #include "ademono/core/error.h"
 #include "ademono/depth/depth_factory.h"
@@ -38,14 +39,22 @@ struct InferArgs {
   std::string out;
 };
 
+// "START:END", END exclusive, either may be empty.
 void ParseFrames(const std::string& text, size_t* start, size_t* end) {
-  static const std::regex pattern("^(\\d*):(\\d*)$");
-  std::smatch m;
-  if (!std::regex_match(text, m, pattern)) {
+  const size_t colon = text.find(':');
+  auto parse = [&](const std::string& part, size_t* value) {
+    if (part.empty()) return true;
+    if (part.size() > 12 ||
+        !std::all_of(part.begin(), part.end(), [](unsigned char c) { return std::isdigit(c); })) {
+      return false;
+    }
+    *value = std::stoull(part);
+    return true;
+  };
+  if (colon == std::string::npos || !parse(text.substr(0, colon), start) ||
+      !parse(text.substr(colon + 1), end)) {
     throw ademono::InputError("--frames '" + text + "': expected START:END (either may be empty)");
   }
-  if (!m[1].str().empty()) *start = std::stoull(m[1].str());
-  if (!m[2].str().empty()) *end = std::stoull(m[2].str());
   if (*end <= *start) {
     throw ademono::InputError("--frames '" + text + "': END must be greater than START");
   }

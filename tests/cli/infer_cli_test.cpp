@@ -65,6 +65,7 @@ TEST(InferCliTest, BadInputLeavesNoOutput) {
       {base, "nothing to do"},
       {base + "--depth-model " + metric + " --frames 5:2", "END must be greater"},
       {base + "--depth-model " + metric + " --frames 9000:", "only 600 frames"},
+      {base + "--depth-model " + metric + " --frames 1-5", "expected START:END"},
       {base + "--depth-model model:" + (kModels / "depth_bad_output.onnx").string(), "1x2x48x64"},
       {base + "--detector model:" + (dir / "missing.onnx").string(), "missing.onnx"},
       {"infer --dataset 7scenes:" + (dir / "nowhere").string() + " --out " + out.string() +
