@@ -99,15 +99,15 @@ TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
     std::string args, needle;
   };
   const Case cases[] = {
-      {"--config " + bad_config.string(), bad_config.string()},
-      {"--config /nonexistent/config.yaml", "/nonexistent/config.yaml"},
+      {"--frames 0:5 --config " + bad_config.string(), bad_config.string()},
+      {"--frames 0:5 --config /nonexistent/config.yaml", "/nonexistent/config.yaml"},
       {"--frames 10:5", "--frames"},
-      {"--depth cache:/nonexistent/depth", "/nonexistent/depth"},
-      {"--depth warp", "unknown depth provider"},
-      {"--seed abc", "--seed"},
+      {"--frames 0:5 --depth cache:/nonexistent/depth", "/nonexistent/depth"},
+      {"--frames 0:5 --depth warp", "unknown depth provider"},
+      {"--frames 0:5 --seed abc", "--seed"},
   };
   for (const Case& c : cases) {
-    const CommandResult r = RunCli("run --dataset " + Dataset() + " --frames 0:5 " + c.args + " --out " + out_.string());
+    const CommandResult r = RunCli("run --dataset " + Dataset() + " " + c.args + " --out " + out_.string());
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.output;
     EXPECT_NE(r.output.find("ademono run: error:"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(c.needle), std::string::npos) << r.output;
