@@ -7,7 +7,8 @@ same on an idle machine and on one shared with compilers; wall time is logged as
 
 Example (the small variant on 7-Scenes frames 0-399, see docs/depthnet.md):
   nice -n 10 python3 tools/depthnet/train.py --data 7scenes:../shared/data/7scenes-seq-a \
-      --frames 0:400 --out tools/depthnet/runs/small --epochs 20 --time-budget 28
+      --frames 0:400 --val-frames 400:600 --out tools/depthnet/runs/small --epochs 20 \
+      --pretrain-epochs 3 --time-budget 29
 """
 
 from __future__ import annotations

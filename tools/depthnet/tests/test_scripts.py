@@ -2,20 +2,16 @@
 
 import json
 import os
-import subprocess
-import sys
 
 import cv2
 import numpy as np
 import onnx
-import pytest
 import torch
 import yaml
 
 import evaluate
 import export_onnx
 import train
-from depthnet.checkpoint import load_model
 
 
 def make_scene(root, n=8, w=64, h=48):
