@@ -54,6 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--variant", choices=sorted(VARIANTS), default="small")
     p.add_argument("--input-size", type=parse_size, default=None, help="WxH (default: variant's)")
     p.add_argument("--channels", default="", help="encoder channels, e.g. 16,32,64,128 (width/depth)")
+    p.add_argument("--blocks-per-stage", type=int, default=-1, help="extra convs per encoder stage")
+    p.add_argument("--decoder-channels", type=int, default=0, help="decoder base width")
     p.add_argument("--seed-bins", type=int, default=0, help="Ns (default: variant's)")
     p.add_argument("--max-depth", type=float, default=0.0, help="metric range top (default: variant's)")
     p.add_argument("--epochs", type=int, default=20)
@@ -80,6 +82,10 @@ def make_config(args) -> ModelConfig:
         cfg.input_width, cfg.input_height = args.input_size
     if args.channels:
         cfg.encoder_channels = tuple(int(c) for c in args.channels.split(","))
+    if args.blocks_per_stage >= 0:
+        cfg.blocks_per_stage = args.blocks_per_stage
+    if args.decoder_channels:
+        cfg.decoder_channels = args.decoder_channels
     if args.seed_bins:
         cfg.num_seed_bins = args.seed_bins
     if args.max_depth:
@@ -133,7 +139,11 @@ def main(argv=None) -> int:
         print(f"train.py: error: {e}", file=sys.stderr)
         return 2
 
-    cfg = make_config(args)
+    try:
+        cfg = make_config(args)
+    except ValueError as e:
+        print(f"train.py: error: model configuration: {e}", file=sys.stderr)
+        return 2
     model = DepthNet(cfg)
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=args.weight_decay)
     start_epoch, elapsed = 0, 0.0

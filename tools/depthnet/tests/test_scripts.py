@@ -83,6 +83,20 @@ def test_committed_spec_matches_small_variant(tool_dir):
     assert open(committed).read() == export_onnx.spec_yaml(DepthNet(SMALL), "ademono_depthnet_small")
 
 
+def test_width_and_depth_options(tmp_path):
+    data = str(tmp_path / "scene")
+    make_scene(data, n=4)
+    out = str(tmp_path / "wide")
+    assert train.main(["--data", "7scenes:" + data, "--out", out, "--variant", "tiny", "--epochs", "1",
+                       "--pretrain-epochs", "0", "--batch-size", "2", "--cache-size", "64x48",
+                       "--channels", "4,8,8,16", "--blocks-per-stage", "2", "--decoder-channels", "6",
+                       "--seed-bins", "3", "--input-size", "64x48"]) == 0
+    cfg = torch.load(os.path.join(out, "last.pt"))["config"]
+    assert cfg["encoder_channels"] == [4, 8, 8, 16] and cfg["blocks_per_stage"] == 2
+    assert cfg["decoder_channels"] == 6 and cfg["num_seed_bins"] == 3
+    assert (cfg["input_width"], cfg["input_height"]) == (64, 48)
+
+
 def test_train_rejects_bad_input(tmp_path, capsys):
     assert train.main(["--data", "7scenes:" + str(tmp_path / "missing"), "--out", str(tmp_path / "o")]) == 2
     assert "missing: not a directory" in capsys.readouterr().err
@@ -92,6 +106,9 @@ def test_train_rejects_bad_input(tmp_path, capsys):
     assert train.main(["--data", "7scenes:" + str(tmp_path / "scene"), "--out", str(tmp_path / "o"),
                        "--resume"]) == 2
     assert "no checkpoint to resume from" in capsys.readouterr().err
+    assert train.main(["--data", "7scenes:" + str(tmp_path / "scene"), "--out", str(tmp_path / "o"),
+                       "--input-size", "50x40"]) == 2
+    assert "model configuration: input size must be divisible by 16" in capsys.readouterr().err
     bad = tmp_path / "bad.pt"
     bad.write_bytes(b"garbage")
     assert evaluate.main(["--checkpoint", str(bad), "--data", "7scenes:" + str(tmp_path)]) == 2
