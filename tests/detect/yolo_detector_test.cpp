@@ -115,6 +115,10 @@ TEST(YoloDecodeTest, Yolov5AndYolov8Layouts) {
   ExpectBox(c8[0], 1, 0.35f, {8, 17, 4, 6});
   Tensor wrong;
   wrong.shape = {2, 3};
+  Tensor short_data;
+  short_data.shape = {1, 2, 7};
+  short_data.data.assign(7, 0.f);
+  EXPECT_THROW(DecodeYolov5(short_data, 0.3f), std::invalid_argument);
   EXPECT_THROW(DecodeYolov5(wrong, 0.3f), std::invalid_argument);
   EXPECT_THROW(DecodeYolov8(wrong, 0.3f), std::invalid_argument);
 }

@@ -36,6 +36,12 @@ std::pair<int64_t, int64_t> RowsCols(const Tensor& output, const char* layout) {
     throw std::invalid_argument(std::string("expected a 1xNxK output for ") + layout + ", got " +
                                 ShapeToString(output.shape));
   }
+  if (output.shape[1] < 0 || output.shape[2] < 0 ||
+      static_cast<size_t>(output.shape[1] * output.shape[2]) != output.data.size()) {
+    throw std::invalid_argument(std::string(layout) + " output " + ShapeToString(output.shape) +
+                                " does not match its " + std::to_string(output.data.size()) +
+                                " values");
+  }
   return {output.shape[1], output.shape[2]};
 }
 
