@@ -177,7 +177,7 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
     for (int side : {-1, 1}) {
       scene.static_boxes.push_back(MakeBox(
           At(x + segment, 36.0 * side, -0.05), {segment, 25.0, 0.05},
-          textures.Make(TextureStyle::kFloor, 2 * segment, 50.0, 0.05, {0.45f, 0.8f, 0.55f})));
+          textures.Make(TextureStyle::kFloor, 2 * segment, 50.0, 0.08, {0.45f, 0.8f, 0.55f})));
     }
   }
   // Buildings along both sides; facades 11 to 40 m to the side.
@@ -277,6 +277,10 @@ void SceneOptions::Check() const {
   if (scene != "office" && scene != "street")
     throw std::invalid_argument("unknown scene '" + scene + "' (expected office or street)");
   if (frames < 1 || frames > 100000) throw std::invalid_argument("frames must be in [1, 100000]");
+  // The street is built (and textured) for the whole drive up front: ~16 MB of textures per
+  // 100 m, so it is capped at 2000 frames (2 km).
+  if (scene == "street" && frames > 2000)
+    throw std::invalid_argument("street: frames must be in [1, 2000] (the road is 1 m per frame)");
   if (width < 0 || height < 0 || (width > 0 && width < 16) || (height > 0 && height < 16) ||
       width > 8192 || height > 8192)
     throw std::invalid_argument("width and height must be in [16, 8192]");

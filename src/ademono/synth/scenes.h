@@ -21,7 +21,7 @@ namespace ademono::synth {
 struct SceneOptions {
   std::string scene = "office";      // "office" | "street"
   std::optional<MotionKind> motion;  // default: xyz (office), forward (street)
-  size_t frames = 100;               // the street is built long enough for them
+  size_t frames = 100;               // the street is built long enough for them (<= 2000)
   uint64_t seed = 0;
   int width = 0, height = 0;  // 0: the scene's default; intrinsics scale with the size
   int persons = 2;            // office: walking persons (1..3)
