@@ -1,6 +1,7 @@
 // Speed of the synthetic data generator: rendering one frame (ray casting, textures, masks'
 // object ids) on ONE thread, the simulated depth network, and building a scene (textures).
 #include <benchmark/benchmark.h>
+
 #include <opencv2/core/utility.hpp>
 
 #include "ademono/depth/simulated_depth.h"
