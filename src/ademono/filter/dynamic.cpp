@@ -106,8 +106,14 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
 
   // Background motion: mean displacement of the t closest matches outside every grown box.
   std::vector<cv::DMatch> background;
-  for (const cv::DMatch& m : matches)
-    if (!in_any[static_cast<size_t>(m.queryIdx)]) background.push_back(m);
+  auto finite = [](const cv::Point2f& p) { return std::isfinite(p.x) && std::isfinite(p.y); };
+  for (const cv::DMatch& m : matches) {
+    // Non-finite positions would turn the mean into NaN and silently disable stage 1.
+    if (!in_any[static_cast<size_t>(m.queryIdx)] &&
+        finite(kps[static_cast<size_t>(m.queryIdx)].pt) &&
+        finite(prev.keypoints[static_cast<size_t>(m.trainIdx)].pt))
+      background.push_back(m);
+  }
   std::stable_sort(
       background.begin(), background.end(),
       [](const cv::DMatch& a, const cv::DMatch& b) { return a.distance < b.distance; });

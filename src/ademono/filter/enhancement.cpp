@@ -70,13 +70,16 @@ std::vector<int> SelectInBlock(const std::vector<int>& members,
   chosen.push_back(members[current]);
   while (chosen.size() < keep) {
     size_t best = n;
-    double best_weight = -1.0;
+    double best_weight = -std::numeric_limits<double>::infinity();
     const cv::Point2f& from = points[static_cast<size_t>(members[current])];
     for (size_t k = 0; k < n; ++k) {
       if (taken[k]) continue;
       const int idx = members[k];
-      const double w = EnhancementWeight(from, points[static_cast<size_t>(idx)], depth_of(idx),
-                                         min_depth, max_depth, p_percent, q_percent);
+      double w = EnhancementWeight(from, points[static_cast<size_t>(idx)], depth_of(idx), min_depth,
+                                   max_depth, p_percent, q_percent);
+      // A NaN position gives a NaN weight: rank it below every real candidate (weights are >= 0)
+      // so the walk still picks exactly `keep` points.
+      if (std::isnan(w)) w = -1.0;
       // Strictly greater: ties keep the earlier member (members are in ascending index order).
       if (w > best_weight) {
         best_weight = w;
