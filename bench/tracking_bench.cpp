@@ -26,7 +26,8 @@ struct Data {
 const Data& LoadData() {
   static const Data data = [] {
     Data d;
-    d.sequence = ademono::OpenSequence(std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a");
+    d.sequence =
+        ademono::OpenSequence(std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a");
     ademono::DepthFactoryContext context;
     context.sequence = d.sequence.get();
     auto provider = ademono::MakeDepthProvider("sensor", context);

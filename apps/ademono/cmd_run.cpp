@@ -1,34 +1,32 @@
 // `ademono run`: SLAM over a dataset sequence. Writes trajectory.tum, trajectory.kitti,
 // keyframes.tum, map.ply and summary.json into --out (each atomically), optionally per-frame
 // feature images into --viz.
+#include <spdlog/spdlog.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
 
-#include <nlohmann/json.hpp>
-#include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
-
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
 #include "ademono/depth/depth_factory.h"
-#include "ademono/eval/trajectory_eval.h"
 #include "ademono/detect/detector_factory.h"
+#include "ademono/eval/trajectory_eval.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
 #include "ademono/slam/pipeline.h"
 #include "ademono/slam/system.h"
 #include "command.h"
-
 
 namespace fs = std::filesystem;
 
@@ -55,13 +53,16 @@ struct RunArgs {
 // Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
 // binary was built from (bin/ is build/<name>/bin).
 fs::path FindConfigDir() {
-  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0') return env;
+  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0')
+    return env;
   if (fs::is_directory("configs")) return "configs";
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
-      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt")) return dir / "configs";
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
+         dir = dir.parent_path()) {
+      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt"))
+        return dir / "configs";
     }
   }
   return {};
@@ -72,13 +73,15 @@ fs::path FindConfigDir() {
 std::string DefaultConfigName(const std::string& kind, const std::string& path) {
   if (kind == "tum") {
     std::smatch m;
-    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])"))) return "tum_fr" + m[2].str() + ".yaml";
+    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])")))
+      return "tum_fr" + m[2].str() + ".yaml";
     return "tum_fr1.yaml";
   }
   if (kind == "kitti") {
     std::smatch m;
     int sequence = 0;
-    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)"))) sequence = std::stoi(m[1].str());
+    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)")))
+      sequence = std::stoi(m[1].str());
     if (sequence <= 2) return "kitti_00-02.yaml";
     if (sequence == 3) return "kitti_03.yaml";
     return "kitti_04-12.yaml";
@@ -145,12 +148,20 @@ void WriteViz(const fs::path& dir, const FrameData& frame, const TrackResult& r)
   for (size_t i = 0; i < r.keypoints.size() && i < r.labels.size(); ++i) {
     cv::Scalar color;
     switch (r.labels[i]) {
-      case PointLabel::kKept: color = {0, 255, 0}; break;
-      case PointLabel::kEnhancementDropped: color = {160, 160, 160}; break;
+      case PointLabel::kKept:
+        color = {0, 255, 0};
+        break;
+      case PointLabel::kEnhancementDropped:
+        color = {160, 160, 160};
+        break;
       case PointLabel::kDynamicSmallBox:
       case PointLabel::kDynamicStage1:
-      case PointLabel::kDynamicStage2: color = {0, 0, 255}; break;
-      case PointLabel::kDistantDropped: color = {255, 0, 0}; break;
+      case PointLabel::kDynamicStage2:
+        color = {0, 0, 255};
+        break;
+      case PointLabel::kDistantDropped:
+        color = {255, 0, 0};
+        break;
     }
     cv::circle(canvas, r.keypoints[i].pt, 3, color, 1, cv::LINE_AA);
   }
@@ -233,7 +244,8 @@ int Run(const RunArgs& args) {
   PipelineOptions pipeline;
   if (!args.frames.empty()) ParseFrames(args.frames, &pipeline.start, &pipeline.end);
   if (pipeline.start >= sequence->Size()) {
-    throw InputError("--frames '" + args.frames + "': sequence has only " + std::to_string(sequence->Size()) + " frames");
+    throw InputError("--frames '" + args.frames + "': sequence has only " +
+                     std::to_string(sequence->Size()) + " frames");
   }
   pipeline.overlap = !args.no_overlap;
 
@@ -266,17 +278,21 @@ int Run(const RunArgs& args) {
                    std::string(width - filled, ' ').c_str(), done, total, fps, lost_so_far);
       if (done == total) std::fprintf(stderr, "\n");
     } else if (done % 100 == 0 || done == total) {
-      std::fprintf(stderr, "ademono run: %zu/%zu frames, %.1f fps, lost %d\n", done, total, fps, lost_so_far);
+      std::fprintf(stderr, "ademono run: %zu/%zu frames, %.1f fps, lost %d\n", done, total, fps,
+                   lost_so_far);
     }
   };
-  const PipelineResult result = RunPipeline(*sequence, depth.get(), detector.get(), system, pipeline);
+  const PipelineResult result =
+      RunPipeline(*sequence, depth.get(), detector.get(), system, pipeline);
   system.Shutdown();
 
   // Outputs.
   const Trajectory trajectory = system.FrameTrajectory();
   const Trajectory keyframes = system.KeyFrameTrajectory();
   if (trajectory.empty()) {
-    throw InputError(args.dataset + ": no frame could be tracked (the map never initialised: too little valid depth?)");
+    throw InputError(
+        args.dataset +
+        ": no frame could be tracked (the map never initialised: too little valid depth?)");
   }
   WriteTumTrajectory(out / "trajectory.tum", trajectory);
   WriteKittiTrajectory(out / "trajectory.kitti", trajectory);
@@ -310,22 +326,24 @@ int Run(const RunArgs& args) {
   summary["map_points"] = system.NumMapPoints();
   summary["wall_seconds"] = result.wall_seconds;
   summary["fps"] = result.wall_seconds > 0 ? result.frames / result.wall_seconds : 0.0;
-  summary["timing"] = {{"extraction", TimingJson(extraction)}, {"depth", TimingJson(depth_ms)},
-                       {"detection", TimingJson(detection)},   {"filter", TimingJson(filter)},
-                       {"tracking", TimingJson(tracking)},     {"local_mapping", TimingJson(mapping)}};
+  summary["timing"] = {
+      {"extraction", TimingJson(extraction)}, {"depth", TimingJson(depth_ms)},
+      {"detection", TimingJson(detection)},   {"filter", TimingJson(filter)},
+      {"tracking", TimingJson(tracking)},     {"local_mapping", TimingJson(mapping)}};
   if (sequence->HasGroundTruth()) {
     const nlohmann::json accuracy = AccuracyJson(result.ground_truth_frames, trajectory);
     if (!accuracy.is_null()) summary["accuracy"] = accuracy;
   }
   WriteTextFileAtomic(out / "summary.json", summary.dump(2) + "\n");
 
-  std::cout << "tracked " << trajectory.size() << "/" << result.frames << " frames (lost " << system.NumLost()
-            << "), " << system.NumKeyFrames() << " keyframes, " << system.NumMapPoints()
-            << " map points; tracking median " << std::fixed << std::setprecision(1)
-            << Percentile(tracking, 0.5) << " ms/frame\n";
+  std::cout << "tracked " << trajectory.size() << "/" << result.frames << " frames (lost "
+            << system.NumLost() << "), " << system.NumKeyFrames() << " keyframes, "
+            << system.NumMapPoints() << " map points; tracking median " << std::fixed
+            << std::setprecision(1) << Percentile(tracking, 0.5) << " ms/frame\n";
   if (summary.contains("accuracy")) {
-    std::cout << "ATE se3 " << std::setprecision(4) << summary["accuracy"]["ate_se3_rmse_m"].get<double>()
-              << " m, sim3 " << summary["accuracy"]["ate_sim3_rmse_m"].get<double>() << " m\n";
+    std::cout << "ATE se3 " << std::setprecision(4)
+              << summary["accuracy"]["ate_se3_rmse_m"].get<double>() << " m, sim3 "
+              << summary["accuracy"]["ate_sim3_rmse_m"].get<double>() << " m\n";
   }
   if (trajectory.size() < result.frames) {
     std::cout << (result.frames - trajectory.size()) << " frames untracked (no pose written)\n";
@@ -337,20 +355,30 @@ const bool kRegistered = RegisterCommand(
     "run", "Run SLAM over a dataset sequence and write trajectory, keyframes, map and summary",
     [](CLI::App& app) -> Runner {
       auto args = std::make_shared<RunArgs>();
-      app.add_option("--dataset", args->dataset, "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")->required();
+      app.add_option("--dataset", args->dataset,
+                     "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")
+          ->required();
       app.add_option("--config", args->config, "config YAML (default: configs/<family>.yaml)");
-      app.add_option("--depth", args->depth, "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
+      app.add_option("--depth", args->depth,
+                     "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
           ->capture_default_str();
       app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
           ->capture_default_str();
       app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
-      app.add_option("--seed", args->seed, "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
-      app.add_flag("--no-enhancement", args->no_enhancement, "disable depth-weighted feature enhancement");
-      app.add_flag("--no-dynamic-removal", args->no_dynamic_removal, "disable dynamic interference removal");
-      app.add_flag("--no-distant-filter", args->no_distant_filter, "disable distant-point filtering");
-      app.add_flag("--threaded", args->threaded,
-                   "local mapping in its own thread (faster wall time, not reproducible run to run)");
-      app.add_flag("--no-overlap", args->no_overlap, "compute depth/detections sequentially (no prefetch)");
+      app.add_option(
+          "--seed", args->seed,
+          "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
+      app.add_flag("--no-enhancement", args->no_enhancement,
+                   "disable depth-weighted feature enhancement");
+      app.add_flag("--no-dynamic-removal", args->no_dynamic_removal,
+                   "disable dynamic interference removal");
+      app.add_flag("--no-distant-filter", args->no_distant_filter,
+                   "disable distant-point filtering");
+      app.add_flag(
+          "--threaded", args->threaded,
+          "local mapping in its own thread (faster wall time, not reproducible run to run)");
+      app.add_flag("--no-overlap", args->no_overlap,
+                   "compute depth/detections sequentially (no prefetch)");
       app.add_option("--viz", args->viz, "write per-frame images with filter labels into DIR");
       app.add_option("--camera", args->camera, "camera YAML (overrides the dataset's)");
       app.add_option("--out", args->out, "output directory")->required();

@@ -1,15 +1,14 @@
 // End-to-end tests of `ademono run` on a short 7-Scenes slice.
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -42,12 +41,15 @@ std::string ReadAll(const fs::path& path) {
 class RunCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    out_ = fs::temp_directory_path() / ("ademono_run_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    out_ = fs::temp_directory_path() /
+           ("ademono_run_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(out_);
   }
   void TearDown() override { fs::remove_all(out_); }
-  std::string Dataset() const { return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a"; }
+  std::string Dataset() const {
+    return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a";
+  }
   std::string Config() const { return std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml"; }
   fs::path out_;
 };
@@ -56,7 +58,8 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
   const CommandResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
                                  " --frames 0:30 --out " + out_.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const char* name : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "summary.json"}) {
+  for (const char* name :
+       {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out_ / name)) << name;
   }
   const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
@@ -65,29 +68,37 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
   EXPECT_EQ(summary["lost"], 0);
   EXPECT_GE(summary["keyframes"].get<int>(), 1);
   EXPECT_GT(summary["map_points"].get<int>(), 100);
-  for (const char* module : {"extraction", "depth", "detection", "filter", "tracking", "local_mapping"}) {
+  for (const char* module :
+       {"extraction", "depth", "detection", "filter", "tracking", "local_mapping"}) {
     EXPECT_TRUE(summary["timing"].contains(module)) << module;
     EXPECT_GE(summary["timing"][module]["p95_ms"].get<double>(),
               summary["timing"][module]["median_ms"].get<double>());
   }
   // 30 TUM lines, 30 KITTI lines, a PLY header with the vertex count.
   int tum_lines = 0, kitti_lines = 0;
-  std::istringstream tum(ReadAll(out_ / "trajectory.tum")), kitti(ReadAll(out_ / "trajectory.kitti"));
-  for (std::string line; std::getline(tum, line);) tum_lines += (!line.empty() && line[0] != '#') ? 1 : 0;
+  std::istringstream tum(ReadAll(out_ / "trajectory.tum")),
+      kitti(ReadAll(out_ / "trajectory.kitti"));
+  for (std::string line; std::getline(tum, line);)
+    tum_lines += (!line.empty() && line[0] != '#') ? 1 : 0;
   for (std::string line; std::getline(kitti, line);) kitti_lines += line.empty() ? 0 : 1;
   EXPECT_EQ(tum_lines, 30);
   EXPECT_EQ(kitti_lines, 30);
   const std::string ply = ReadAll(out_ / "map.ply");
   EXPECT_EQ(ply.rfind("ply\n", 0), 0u);
-  EXPECT_NE(ply.find("element vertex " + std::to_string(summary["map_points"].get<int>())), std::string::npos);
+  EXPECT_NE(ply.find("element vertex " + std::to_string(summary["map_points"].get<int>())),
+            std::string::npos);
 }
 
 TEST_F(RunCliTest, TwoRunsWriteIdenticalTrajectories) {
   const fs::path second = out_ / "second";
-  ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 200:225 --out " +
-                   (out_ / "first").string()).exit_code, 0);
-  ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 200:225 --no-overlap --out " +
-                   second.string()).exit_code, 0);
+  ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                   " --frames 200:225 --out " + (out_ / "first").string())
+                .exit_code,
+            0);
+  ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                   " --frames 200:225 --no-overlap --out " + second.string())
+                .exit_code,
+            0);
   EXPECT_EQ(ReadAll(out_ / "first" / "trajectory.tum"), ReadAll(second / "trajectory.tum"));
   EXPECT_FALSE(ReadAll(second / "trajectory.tum").empty());
 }
@@ -107,7 +118,8 @@ TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
       {"--frames 0:5 --seed abc", "--seed"},
   };
   for (const Case& c : cases) {
-    const CommandResult r = RunCli("run --dataset " + Dataset() + " " + c.args + " --out " + out_.string());
+    const CommandResult r =
+        RunCli("run --dataset " + Dataset() + " " + c.args + " --out " + out_.string());
     EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.output;
     EXPECT_NE(r.output.find("ademono run: error:"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(c.needle), std::string::npos) << r.output;

@@ -1,11 +1,10 @@
 #include "ademono/depth/cache_depth.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "ademono/core/error.h"
@@ -79,9 +78,7 @@ TEST_F(CacheDepthTest, RejectsEmptyFolderAndBadFiles) {
   FrameData frame;
   frame.name = "image_a";
   EXPECT_THROW(provider.Depth(frame, Camera{}), InputError);  // three channels
-  {
-    std::ofstream(dir_ / "image_b.png") << "not an image";
-  }
+  { std::ofstream(dir_ / "image_b.png") << "not an image"; }
   CacheDepthProvider provider2(dir_);
   frame.name = "image_b";
   EXPECT_THROW(provider2.Depth(frame, Camera{}), InputError);

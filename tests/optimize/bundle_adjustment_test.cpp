@@ -1,8 +1,8 @@
 #include "ademono/optimize/bundle_adjustment.h"
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 namespace ademono {
 namespace {
@@ -24,18 +24,21 @@ BundleAdjustmentProblem MakeProblem(std::mt19937& rng, std::vector<Rigid3d>* tru
   for (int p = 0; p < 150; ++p) true_points->emplace_back(xy(rng), xy(rng), z(rng));
   for (int c = 0; c < 3; ++c) {
     Rigid3d start = (*true_poses)[c];
-    if (c > 0) start.translation() += Eigen::Vector3d(pose_noise(rng), pose_noise(rng), pose_noise(rng));
+    if (c > 0)
+      start.translation() += Eigen::Vector3d(pose_noise(rng), pose_noise(rng), pose_noise(rng));
     problem.cameras.push_back({start, c == 0});
   }
   for (const auto& x : *true_points) {
-    problem.points.push_back(x + Eigen::Vector3d(point_noise(rng), point_noise(rng), point_noise(rng)));
+    problem.points.push_back(x +
+                             Eigen::Vector3d(point_noise(rng), point_noise(rng), point_noise(rng)));
   }
   for (size_t p = 0; p < true_points->size(); ++p) {
     for (size_t c = 0; c < 3; ++c) {
       const Eigen::Vector3d pc = (*true_poses)[c] * (*true_points)[p];
       ImageObservation o;
       const double u = kIntrinsics.fx * pc.x() / pc.z() + kIntrinsics.cx;
-      o.pixel = Eigen::Vector2d(u + pixel_noise(rng), kIntrinsics.fy * pc.y() / pc.z() + kIntrinsics.cy + pixel_noise(rng));
+      o.pixel = Eigen::Vector2d(u + pixel_noise(rng), kIntrinsics.fy * pc.y() / pc.z() +
+                                                          kIntrinsics.cy + pixel_noise(rng));
       if (p % 2 == 0) o.u_right = u - kIntrinsics.bf / pc.z() + pixel_noise(rng);
       problem.observations.push_back({c, p, o});
     }

@@ -1,8 +1,8 @@
 #include "ademono/optimize/pose_optimizer.h"
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 namespace ademono {
 namespace {
@@ -11,7 +11,8 @@ constexpr PinholeIntrinsics kIntrinsics{585, 585, 320, 240, 585 * 0.08};
 
 Rigid3d TruePose() {
   Rigid3d pose = Rigid3d::Identity();
-  pose.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix();
+  pose.linear() =
+      Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix();
   pose.translation() = Eigen::Vector3d(0.1, -0.05, 0.2);
   return pose;
 }
@@ -46,7 +47,8 @@ TEST(PoseOptimizerTest, RecoversPoseFromPerturbedStartWithDepth) {
   const auto observations = MakeObservations(truth, 300, true, rng);
   Rigid3d start = truth;
   start.translation() += Eigen::Vector3d(0.05, -0.03, 0.04);
-  start.linear() = start.linear() * Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  start.linear() =
+      start.linear() * Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitY()).toRotationMatrix();
   const PoseOptimizationResult result = OptimizePose(kIntrinsics, start, observations);
   EXPECT_LT(TranslationError(result.cam_from_world, truth), 0.005);
   EXPECT_GT(result.num_inliers, 270);
@@ -66,7 +68,8 @@ TEST(PoseOptimizerTest, FlagsGrossOutliers) {
   std::mt19937 rng(3);
   const Rigid3d truth = TruePose();
   auto observations = MakeObservations(truth, 200, true, rng);
-  for (size_t i = 0; i < observations.size(); i += 5) observations[i].image.pixel += Eigen::Vector2d(40, -30);
+  for (size_t i = 0; i < observations.size(); i += 5)
+    observations[i].image.pixel += Eigen::Vector2d(40, -30);
   const PoseOptimizationResult result = OptimizePose(kIntrinsics, truth, observations);
   for (size_t i = 0; i < observations.size(); i += 5) EXPECT_TRUE(result.outlier[i]) << i;
   EXPECT_LT(TranslationError(result.cam_from_world, truth), 0.005);
@@ -84,7 +87,8 @@ TEST(PoseOptimizerTest, DeterministicAndEmptyInput) {
   EXPECT_TRUE(a.cam_from_world.matrix() == b.cam_from_world.matrix());
   const auto empty = OptimizePose(kIntrinsics, start, {});
   EXPECT_TRUE(empty.cam_from_world.matrix() == start.matrix());
-  EXPECT_THROW(OptimizePose(kIntrinsics, start, observations, {0, 10, false}), std::invalid_argument);
+  EXPECT_THROW(OptimizePose(kIntrinsics, start, observations, {0, 10, false}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -34,7 +34,8 @@ std::shared_ptr<const FrameFeatures> Features(const std::vector<cv::Point2f>& po
 }
 
 TEST(FrameFeaturesTest, GridSearchAndVirtualRightCoordinate) {
-  const auto f = Features({{100, 100}, {105, 102}, {300, 200}, {639, 479}}, {1.0f, -1.f, 2.0f, 0.f}, 1);
+  const auto f =
+      Features({{100, 100}, {105, 102}, {300, 200}, {639, 479}}, {1.0f, -1.f, 2.0f, 0.f}, 1);
   EXPECT_EQ(f->FeaturesInArea(102, 101, 10), (std::vector<size_t>{0, 1}));
   EXPECT_EQ(f->FeaturesInArea(300, 200, 2), (std::vector<size_t>{2}));
   EXPECT_TRUE(f->FeaturesInArea(300, 200, 2, 1, 3).empty());  // all on level 0
@@ -51,7 +52,8 @@ TEST(FrameFeaturesTest, GridSearchAndVirtualRightCoordinate) {
 
 TEST(MatcherTest, ProjectionSearchFindsTheSameDescriptorsUnderSmallMotion) {
   Map map;
-  const auto f0 = Features({{100, 100}, {200, 150}, {400, 300}, {500, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
+  const auto f0 =
+      Features({{100, 100}, {200, 150}, {400, 300}, {500, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
   Frame first(0, 0, 0.0, f0);
   first.cam_from_world = Rigid3d::Identity();
   auto kf = map.CreateKeyFrame(first);
@@ -64,7 +66,8 @@ TEST(MatcherTest, ProjectionSearchFindsTheSameDescriptorsUnderSmallMotion) {
     first.map_points[i] = p;
   }
   // The next frame sees the same points shifted by 3 px (same descriptors).
-  const auto f1 = Features({{103, 100}, {203, 150}, {403, 300}, {503, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
+  const auto f1 =
+      Features({{103, 100}, {203, 150}, {403, 300}, {503, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
   Frame second(1, 1, 1 / 30.0, f1);
   second.cam_from_world = Rigid3d::Identity();
   const Matcher matcher(0.9f, true);

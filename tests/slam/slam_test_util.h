@@ -11,7 +11,9 @@
 
 namespace ademono::testing_util {
 
-inline std::string SevenScenesSpec() { return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a"; }
+inline std::string SevenScenesSpec() {
+  return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a";
+}
 
 enum class Fault { kNone, kNoDepth, kBlack };
 

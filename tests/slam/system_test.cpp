@@ -28,7 +28,8 @@ Trajectory RunSlice(const Sequence& sequence, const SystemOptions& options, bool
   System system(sequence.GetCamera(), options);
   PipelineOptions pipeline;
   pipeline.overlap = overlap;
-  pipeline.on_frame = [&](const FrameData&, const cv::Mat&, const std::vector<Detection>&, const TrackResult& r) {
+  pipeline.on_frame = [&](const FrameData&, const cv::Mat&, const std::vector<Detection>&,
+                          const TrackResult& r) {
     if (results != nullptr) results->push_back(r);
   };
   RunPipeline(sequence, depth.get(), nullptr, system, pipeline);
@@ -65,9 +66,9 @@ TEST(SystemTest, SurvivesNoDepthBlackAndDuplicatedFrames) {
   std::vector<TrackResult> results;
   const Trajectory trajectory = RunSlice(*sequence, TestOptions(), true, &results);
   ASSERT_EQ(results.size(), 61u);
-  EXPECT_FALSE(results[30].tracked);      // nothing to track in a black frame
+  EXPECT_FALSE(results[30].tracked);  // nothing to track in a black frame
   EXPECT_EQ(results[30].num_keypoints, 0);
-  EXPECT_TRUE(results[15].tracked);       // 2-dof residuals only
+  EXPECT_TRUE(results[15].tracked);  // 2-dof residuals only
   for (size_t i = 32; i < results.size(); ++i) EXPECT_TRUE(results[i].tracked) << "frame " << i;
   EXPECT_GE(trajectory.size(), 59u);
   EXPECT_LT(MaxPositionError(*sequence, trajectory), 0.05);
@@ -91,8 +92,10 @@ TEST(SystemTest, KeypointDepthsRejectInvalidAndEdgeReadings) {
   depth(cv::Rect(10, 0, 10, 20)).setTo(3.0f);  // a step edge at x = 10
   depth.at<float>(5, 3) = 0.f;                 // a hole
   FrameDepthOptions options;
-  const std::vector<cv::KeyPoint> keypoints{{cv::Point2f(4, 10), 1}, {cv::Point2f(9, 10), 1},
-                                            {cv::Point2f(3, 6), 1},  {cv::Point2f(50, 10), 1}};
+  const std::vector<cv::KeyPoint> keypoints{{cv::Point2f(4, 10), 1},
+                                            {cv::Point2f(9, 10), 1},
+                                            {cv::Point2f(3, 6), 1},
+                                            {cv::Point2f(50, 10), 1}};
   const std::vector<float> d = System::KeypointDepths(keypoints, depth, options);
   EXPECT_FLOAT_EQ(d[0], 2.0f);
   EXPECT_LT(d[1], 0);  // next to the edge
@@ -119,7 +122,8 @@ TEST(SystemOptionsTest, YamlErrorsNameTheFile) {
   expect_error("tracking:\n  bogus_key: 1\n", "bogus_key");
   expect_error("depth:\n  min_depth: 5\n  max_depth: 1\n", "min_depth");
   expect_error("nonsense_section: {}\n", "nonsense_section");
-  const SystemOptions ok = SystemOptions::FromYaml(YAML::Load("tracking:\n  min_inliers: 40\n"), path);
+  const SystemOptions ok =
+      SystemOptions::FromYaml(YAML::Load("tracking:\n  min_inliers: 40\n"), path);
   EXPECT_EQ(ok.tracking.min_inliers, 40);
   EXPECT_EQ(ok.tracking.min_init_points, TrackingOptions().min_init_points);
 }

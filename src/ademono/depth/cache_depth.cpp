@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdlib>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -22,8 +21,8 @@ bool ParseStemTimestamp(const std::string& stem, double* value) {
   while (end > 0 && !(std::isdigit(static_cast<unsigned char>(stem[end - 1])))) --end;
   if (end == 0) return false;
   size_t begin = end;
-  while (begin > 0 && (std::isdigit(static_cast<unsigned char>(stem[begin - 1])) ||
-                       stem[begin - 1] == '.')) {
+  while (begin > 0 &&
+         (std::isdigit(static_cast<unsigned char>(stem[begin - 1])) || stem[begin - 1] == '.')) {
     --begin;
   }
   while (begin < end && stem[begin] == '.') ++begin;
@@ -52,7 +51,8 @@ cv::Mat ReadDepthMap(const std::filesystem::path& path) {
     for (int y = 0; y < raw.rows; ++y) {
       const float* in = raw.ptr<float>(y);
       float* out = depth.ptr<float>(y);
-      for (int x = 0; x < raw.cols; ++x) out[x] = (std::isfinite(in[x]) && in[x] > 0.f) ? in[x] : 0.f;
+      for (int x = 0; x < raw.cols; ++x)
+        out[x] = (std::isfinite(in[x]) && in[x] > 0.f) ? in[x] : 0.f;
     }
   } else {
     ThrowInputError(path, "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)");

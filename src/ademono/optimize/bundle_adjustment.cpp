@@ -19,7 +19,8 @@ bool Solve(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip
            std::vector<double>& cameras, std::vector<double>& points) {
   ceres::Problem ceres_problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-  std::vector<bool> point_used(problem.points.size(), false), camera_used(problem.cameras.size(), false);
+  std::vector<bool> point_used(problem.points.size(), false),
+      camera_used(problem.cameras.size(), false);
   for (size_t i = 0; i < problem.observations.size(); ++i) {
     if (skip[i]) continue;
     const BaObservation& o = problem.observations[i];
@@ -28,11 +29,13 @@ bool Solve(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip
     if (o.image.HasDepth()) {
       auto* cost = new ceres::AutoDiffCostFunction<internal::BaResidual<3>, 3, 6, 3>(
           new internal::BaResidual<3>(problem.intrinsics, o.image));
-      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Stereo)), camera, point);
+      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Stereo)), camera,
+                                     point);
     } else {
       auto* cost = new ceres::AutoDiffCostFunction<internal::BaResidual<2>, 2, 6, 3>(
           new internal::BaResidual<2>(problem.intrinsics, o.image));
-      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Mono)), camera, point);
+      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Mono)), camera,
+                                     point);
     }
     point_used[o.point] = true;
     camera_used[o.camera] = true;
@@ -66,9 +69,11 @@ void ClassifyOutliers(const BundleAdjustmentProblem& problem, const std::vector<
   for (size_t c = 0; c < poses.size(); ++c) poses[c] = internal::ParamsToRigid(&cameras[6 * c]);
   for (size_t i = 0; i < problem.observations.size(); ++i) {
     const BaObservation& o = problem.observations[i];
-    const Eigen::Vector3d point(points[3 * o.point], points[3 * o.point + 1], points[3 * o.point + 2]);
+    const Eigen::Vector3d point(points[3 * o.point], points[3 * o.point + 1],
+                                points[3 * o.point + 2]);
     double depth = 0;
-    const double chi2 = internal::ObservationChi2(problem.intrinsics, o.image, poses[o.camera], point, &depth);
+    const double chi2 =
+        internal::ObservationChi2(problem.intrinsics, o.image, poses[o.camera], point, &depth);
     outlier[i] = depth <= 0 || chi2 > (o.image.HasDepth() ? kChi2Stereo : kChi2Mono);
   }
 }

@@ -8,10 +8,9 @@
 // virtual baseline times fx; without depth it is a plain (u, v) measurement. Residuals are scaled
 // by 1 / sigma of the keypoint's pyramid level, so chi2 thresholds are in pixels^2 at level 0.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "ademono/core/geometry.h"
 

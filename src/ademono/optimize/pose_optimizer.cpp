@@ -45,13 +45,13 @@ PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
       if (o.image.HasDepth()) {
         auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<3>, 3, 6>(
             new internal::PoseOnlyResidual<3>(intrinsics, o.image, o.point_world));
-        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Stereo)) : nullptr,
-                                 camera);
+        problem.AddResidualBlock(
+            cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Stereo)) : nullptr, camera);
       } else {
         auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<2>, 2, 6>(
             new internal::PoseOnlyResidual<2>(intrinsics, o.image, o.point_world));
-        problem.AddResidualBlock(cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Mono)) : nullptr,
-                                 camera);
+        problem.AddResidualBlock(
+            cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Mono)) : nullptr, camera);
       }
       ++added;
     }
@@ -63,7 +63,8 @@ PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
     result.num_inliers = 0;
     for (size_t i = 0; i < observations.size(); ++i) {
       const PoseObservation& o = observations[i];
-      const double chi2 = internal::ObservationChi2(intrinsics, o.image, pose, o.point_world, nullptr);
+      const double chi2 =
+          internal::ObservationChi2(intrinsics, o.image, pose, o.point_world, nullptr);
       result.outlier[i] = chi2 > (o.image.HasDepth() ? kChi2Stereo : kChi2Mono);
       if (!result.outlier[i]) ++result.num_inliers;
     }

@@ -4,9 +4,9 @@
 // outlier classification by chi2 after each round; outliers are left out of the next round and
 // may come back if they fit the refined pose. Single-threaded and deterministic.
 
-#include <vector>
-
 #include <yaml-cpp/yaml.h>
+
+#include <vector>
 
 #include "ademono/optimize/optimizer_types.h"
 

@@ -3,11 +3,11 @@
 // (angle-axis rotation, translation) of cam_from_world, which keeps auto-differentiation cheap
 // and needs no manifold.
 
-#include <cmath>
-#include <limits>
-
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
+
+#include <cmath>
+#include <limits>
 
 #include "ademono/optimize/optimizer_types.h"
 
@@ -35,7 +35,11 @@ inline Rigid3d ParamsToRigid(const double* params) {
 template <int kDim>
 struct ProjectionResidual {
   ProjectionResidual(const PinholeIntrinsics& k, const ImageObservation& obs)
-      : k(k), u(obs.pixel.x()), v(obs.pixel.y()), ur(obs.u_right), scale(std::sqrt(obs.inv_sigma2)) {}
+      : k(k),
+        u(obs.pixel.x()),
+        v(obs.pixel.y()),
+        ur(obs.u_right),
+        scale(std::sqrt(obs.inv_sigma2)) {}
 
   template <typename T>
   bool Compute(const T* camera, const T* point_world, T* residual) const {
@@ -94,8 +98,8 @@ inline double ObservationChi2(const PinholeIntrinsics& k, const ImageObservation
   const double inv_z = 1.0 / p.z();
   const double pu = k.fx * p.x() * inv_z + k.cx;
   const double pv = k.fy * p.y() * inv_z + k.cy;
-  double chi2 = (pu - obs.pixel.x()) * (pu - obs.pixel.x()) +
-                (pv - obs.pixel.y()) * (pv - obs.pixel.y());
+  double chi2 =
+      (pu - obs.pixel.x()) * (pu - obs.pixel.x()) + (pv - obs.pixel.y()) * (pv - obs.pixel.y());
   if (obs.HasDepth()) {
     const double ur = pu - k.bf * inv_z;
     chi2 += (ur - obs.u_right) * (ur - obs.u_right);

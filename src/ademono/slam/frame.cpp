@@ -26,10 +26,12 @@ ScalePyramid ScalePyramid::Make(int num_levels, float scale_factor) {
   return p;
 }
 
-std::shared_ptr<const FrameFeatures> MakeFrameFeatures(
-    const Camera& camera, std::shared_ptr<const ScalePyramid> pyramid, double virtual_baseline,
-    double close_depth, std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
-    std::vector<float> depth) {
+std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
+                                                       std::shared_ptr<const ScalePyramid> pyramid,
+                                                       double virtual_baseline, double close_depth,
+                                                       std::vector<cv::KeyPoint> keypoints,
+                                                       cv::Mat descriptors,
+                                                       std::vector<float> depth) {
   auto f = std::make_shared<FrameFeatures>();
   f->camera = camera;
   f->pyramid = std::move(pyramid);
@@ -50,10 +52,11 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(
     for (size_t i = 0; i < n; ++i) f->keypoints_un[i].pt = un[i];
   }
   if (camera.HasDistortion()) {
-    const std::vector<cv::Point2f> corners{{0.f, 0.f},
-                                           {static_cast<float>(camera.width), 0.f},
-                                           {0.f, static_cast<float>(camera.height)},
-                                           {static_cast<float>(camera.width), static_cast<float>(camera.height)}};
+    const std::vector<cv::Point2f> corners{
+        {0.f, 0.f},
+        {static_cast<float>(camera.width), 0.f},
+        {0.f, static_cast<float>(camera.height)},
+        {static_cast<float>(camera.width), static_cast<float>(camera.height)}};
     const std::vector<cv::Point2f> un = camera.Undistort(corners);
     f->min_x = std::min(un[0].x, un[2].x);
     f->max_x = std::max(un[1].x, un[3].x);
@@ -81,7 +84,8 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(
     const cv::Point2f& p = f->keypoints_un[i].pt;
     const int cx = static_cast<int>(std::floor((p.x - f->min_x) / cell_w));
     const int cy = static_cast<int>(std::floor((p.y - f->min_y) / cell_h));
-    if (cx < 0 || cx >= FrameFeatures::kGridCols || cy < 0 || cy >= FrameFeatures::kGridRows) continue;
+    if (cx < 0 || cx >= FrameFeatures::kGridCols || cy < 0 || cy >= FrameFeatures::kGridRows)
+      continue;
     f->grid[cy * FrameFeatures::kGridCols + cx].push_back(i);
   }
   return f;
@@ -123,13 +127,15 @@ Eigen::Vector3d FrameFeatures::UnprojectCamera(size_t i) const {
   return camera.Unproject(Eigen::Vector2d(keypoints_un[i].pt.x, keypoints_un[i].pt.y), depth[i]);
 }
 
-Frame::Frame(uint64_t id, size_t index, double timestamp, std::shared_ptr<const FrameFeatures> features)
+Frame::Frame(uint64_t id, size_t index, double timestamp,
+             std::shared_ptr<const FrameFeatures> features)
     : id(id), index(index), timestamp(timestamp), features(std::move(features)) {
   map_points.resize(this->features->Size());
   outlier.assign(this->features->Size(), false);
 }
 
-bool Frame::InFrustum(const MapPoint& point, float view_cos_limit, ProjectionPrediction* prediction) const {
+bool Frame::InFrustum(const MapPoint& point, float view_cos_limit,
+                      ProjectionPrediction* prediction) const {
   const Eigen::Vector3d pc = *cam_from_world * point.position;
   if (pc.z() <= 0) return false;
   const FrameFeatures& f = *features;

@@ -5,11 +5,10 @@
 
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
@@ -35,22 +34,24 @@ struct FrameFeatures {
 
   Camera camera;
   std::shared_ptr<const ScalePyramid> pyramid;
-  PinholeIntrinsics intrinsics;  // fx, fy, cx, cy, bf
-  float close_depth = 0.f;       // ThDepth in metres
+  PinholeIntrinsics intrinsics;                      // fx, fy, cx, cy, bf
+  float close_depth = 0.f;                           // ThDepth in metres
   float min_x = 0, max_x = 0, min_y = 0, max_y = 0;  // undistorted image bounds
-  std::vector<cv::KeyPoint> keypoints;     // as extracted (distorted pixels)
-  std::vector<cv::KeyPoint> keypoints_un;  // undistorted
-  cv::Mat descriptors;                     // CV_8UC1, 32 bytes per row
-  std::vector<float> depth;                // metres, <= 0 when unknown
-  std::vector<float> u_right;              // u - bf / depth, < 0 when unknown
-  std::vector<std::vector<size_t>> grid;   // kGridCols * kGridRows cells of keypoint indices
+  std::vector<cv::KeyPoint> keypoints;               // as extracted (distorted pixels)
+  std::vector<cv::KeyPoint> keypoints_un;            // undistorted
+  cv::Mat descriptors;                               // CV_8UC1, 32 bytes per row
+  std::vector<float> depth;                          // metres, <= 0 when unknown
+  std::vector<float> u_right;                        // u - bf / depth, < 0 when unknown
+  std::vector<std::vector<size_t>> grid;  // kGridCols * kGridRows cells of keypoint indices
 
   size_t Size() const { return keypoints.size(); }
   // Keypoints whose undistorted position lies within the square window of radius r, on pyramid
   // levels [min_level, max_level] (negative = unbounded). Ascending index order.
   std::vector<size_t> FeaturesInArea(float u, float v, float r, int min_level = -1,
                                      int max_level = -1) const;
-  bool InBounds(float u, float v) const { return u >= min_x && u < max_x && v >= min_y && v < max_y; }
+  bool InBounds(float u, float v) const {
+    return u >= min_x && u < max_x && v >= min_y && v < max_y;
+  }
   ImageObservation Observation(size_t i) const;
   // Camera-frame point of keypoint i from its depth (requires depth[i] > 0).
   Eigen::Vector3d UnprojectCamera(size_t i) const;
@@ -58,10 +59,12 @@ struct FrameFeatures {
 };
 
 // Builds the features: undistorts keypoints, computes u_right and assigns the grid.
-std::shared_ptr<const FrameFeatures> MakeFrameFeatures(
-    const Camera& camera, std::shared_ptr<const ScalePyramid> pyramid, double virtual_baseline,
-    double close_depth, std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
-    std::vector<float> depth);
+std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
+                                                       std::shared_ptr<const ScalePyramid> pyramid,
+                                                       double virtual_baseline, double close_depth,
+                                                       std::vector<cv::KeyPoint> keypoints,
+                                                       cv::Mat descriptors,
+                                                       std::vector<float> depth);
 
 // Where a map point is expected in a frame (filled by Frame::InFrustum for the local-map search).
 struct ProjectionPrediction {
@@ -87,7 +90,8 @@ class Frame {
   Eigen::Vector3d CameraCenter() const { return cam_from_world->inverse().translation(); }
   // Whether `point` can be seen by this frame (in front, inside the image, within its scale
   // range and viewing angle); fills `prediction` when it can.
-  bool InFrustum(const MapPoint& point, float view_cos_limit, ProjectionPrediction* prediction) const;
+  bool InFrustum(const MapPoint& point, float view_cos_limit,
+                 ProjectionPrediction* prediction) const;
   int NumTrackedInliers() const;
 };
 

@@ -41,7 +41,9 @@ class KeyFrame {
 
   const FrameFeatures& F() const { return *features; }
   Eigen::Vector3d CameraCenter() const { return cam_from_world.inverse().translation(); }
-  void AddMapPoint(const std::shared_ptr<MapPoint>& point, size_t index) { map_points[index] = point; }
+  void AddMapPoint(const std::shared_ptr<MapPoint>& point, size_t index) {
+    map_points[index] = point;
+  }
   void EraseMapPoint(size_t index) { map_points[index].reset(); }
   void EraseMapPoint(const MapPoint* point);
   // Map points observed by at least `min_observations` keyframes.

@@ -184,6 +184,9 @@ void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
     std::vector<KeyFrame*> local{&keyframe};
     keyframe.ba_local_for = keyframe.id;
     for (KeyFrame* kf : keyframe.ordered_connections) {
+      if (options_.ba_max_keyframes > 0 &&
+          static_cast<int>(local.size()) >= options_.ba_max_keyframes)
+        break;
       if (kf->bad || kf->ba_local_for == keyframe.id) continue;
       kf->ba_local_for = keyframe.id;
       local.push_back(kf);
@@ -253,7 +256,8 @@ void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
     if (point->observations.empty()) map_.ErasePoint(point.get());
   }
   for (size_t c = 0; c < cameras.size(); ++c) {
-    if (!problem.cameras[c].fixed && !cameras[c]->bad) cameras[c]->cam_from_world = result.cam_from_world[c];
+    if (!problem.cameras[c].fixed && !cameras[c]->bad)
+      cameras[c]->cam_from_world = result.cam_from_world[c];
   }
   for (size_t p = 0; p < points.size(); ++p) {
     if (!points[p] || points[p]->bad) continue;
@@ -278,11 +282,14 @@ void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
       int observers = 0;
       for (const auto& [other, idx] : p->observations) {
         if (other == kf) continue;
-        if (other->F().keypoints_un[idx].octave <= level + 1 && ++observers >= options_.redundant_observers) break;
+        if (other->F().keypoints_un[idx].octave <= level + 1 &&
+            ++observers >= options_.redundant_observers)
+          break;
       }
       if (observers >= options_.redundant_observers) ++num_redundant;
     }
-    if (num_points > 0 && num_redundant > options_.redundant_ratio * num_points) map_.EraseKeyFrame(kf);
+    if (num_points > 0 && num_redundant > options_.redundant_ratio * num_points)
+      map_.EraseKeyFrame(kf);
   }
 }
 

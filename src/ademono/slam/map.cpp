@@ -21,7 +21,8 @@ void Map::ErasePoint(MapPoint* point) {
   const auto observations = point->observations;
   point->observations.clear();
   for (const auto& [kf, idx] : observations) {
-    if (idx < kf->map_points.size() && kf->map_points[idx].get() == point) kf->map_points[idx].reset();
+    if (idx < kf->map_points.size() && kf->map_points[idx].get() == point)
+      kf->map_points[idx].reset();
   }
   points_.erase(point->id);
 }
@@ -95,7 +96,8 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
   }
   if (keyframe->parent != nullptr) {
     keyframe->parent->children.erase(keyframe);
-    keyframe->cam_from_parent = keyframe->cam_from_world * keyframe->parent->cam_from_world.inverse();
+    keyframe->cam_from_parent =
+        keyframe->cam_from_world * keyframe->parent->cam_from_world.inverse();
   }
   keyframe->children.clear();
   keyframe->bad = true;

@@ -8,7 +8,9 @@
 
 namespace ademono {
 
-bool KeyFrameIdLess::operator()(const KeyFrame* a, const KeyFrame* b) const { return a->id < b->id; }
+bool KeyFrameIdLess::operator()(const KeyFrame* a, const KeyFrame* b) const {
+  return a->id < b->id;
+}
 
 MapPoint::MapPoint(uint64_t id, const Eigen::Vector3d& position, KeyFrame* reference,
                    uint64_t first_frame_id)
@@ -22,7 +24,8 @@ void MapPoint::AddObservation(KeyFrame* keyframe, size_t index) { observations[k
 
 void MapPoint::EraseObservation(KeyFrame* keyframe) {
   observations.erase(keyframe);
-  if (reference == keyframe) reference = observations.empty() ? nullptr : observations.begin()->first;
+  if (reference == keyframe)
+    reference = observations.empty() ? nullptr : observations.begin()->first;
 }
 
 void MapPoint::ComputeDistinctiveDescriptor() {

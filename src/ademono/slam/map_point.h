@@ -2,11 +2,10 @@
 // A 3D landmark with its observations in keyframes (ORB-SLAM's MapPoint). All mutable state is
 // guarded by the owning Map's mutex (see map.h).
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <memory>
-
-#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 namespace ademono {
@@ -20,11 +19,12 @@ struct KeyFrameIdLess {
 
 class MapPoint {
  public:
-  MapPoint(uint64_t id, const Eigen::Vector3d& position, KeyFrame* reference, uint64_t first_frame_id);
+  MapPoint(uint64_t id, const Eigen::Vector3d& position, KeyFrame* reference,
+           uint64_t first_frame_id);
 
   const uint64_t id;
   Eigen::Vector3d position;
-  cv::Mat descriptor;            // the most distinctive of the observations' descriptors
+  cv::Mat descriptor;  // the most distinctive of the observations' descriptors
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // mean viewing direction
   float min_distance = 0, max_distance = 0;          // scale invariance range
   KeyFrame* reference = nullptr;
@@ -44,7 +44,9 @@ class MapPoint {
   uint64_t ba_local_for = UINT64_MAX;
 
   int NumObservations() const { return static_cast<int>(observations.size()); }
-  bool IsInKeyFrame(const KeyFrame* keyframe) const { return observations.count(const_cast<KeyFrame*>(keyframe)) > 0; }
+  bool IsInKeyFrame(const KeyFrame* keyframe) const {
+    return observations.count(const_cast<KeyFrame*>(keyframe)) > 0;
+  }
   float FoundRatio() const { return static_cast<float>(found) / static_cast<float>(visible); }
   void AddObservation(KeyFrame* keyframe, size_t index);
   void EraseObservation(KeyFrame* keyframe);  // the point turns bad when it falls below 1 view

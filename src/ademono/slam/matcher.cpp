@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-
 #include <opencv2/features2d.hpp>
 
 #include "ademono/feature/orb_extractor.h"
@@ -19,7 +18,8 @@ float AngleDiff(float a, float b) {
 
 }  // namespace
 
-std::vector<size_t> Matcher::RotationOutliers(const std::vector<std::pair<size_t, float>>& rotations) {
+std::vector<size_t> Matcher::RotationOutliers(
+    const std::vector<std::pair<size_t, float>>& rotations) {
   std::array<std::vector<size_t>, kHistogramBins> bins;
   const float factor = kHistogramBins / 360.f;
   for (const auto& [idx, rot] : rotations) {
@@ -34,15 +34,26 @@ std::vector<size_t> Matcher::RotationOutliers(const std::vector<std::pair<size_t
   for (int i = 0; i < kHistogramBins; ++i) {
     const size_t s = bins[i].size();
     if (s > m1) {
-      m3 = m2; i3 = i2; m2 = m1; i2 = i1; m1 = s; i1 = i;
+      m3 = m2;
+      i3 = i2;
+      m2 = m1;
+      i2 = i1;
+      m1 = s;
+      i1 = i;
     } else if (s > m2) {
-      m3 = m2; i3 = i2; m2 = s; i2 = i;
+      m3 = m2;
+      i3 = i2;
+      m2 = s;
+      i2 = i;
     } else if (s > m3) {
-      m3 = s; i3 = i;
+      m3 = s;
+      i3 = i;
     }
   }
-  if (m2 < 0.1 * m1) i2 = i3 = -1;
-  else if (m3 < 0.1 * m1) i3 = -1;
+  if (m2 < 0.1 * m1)
+    i2 = i3 = -1;
+  else if (m3 < 0.1 * m1)
+    i3 = -1;
   std::vector<size_t> outliers;
   for (int i = 0; i < kHistogramBins; ++i) {
     if (i == i1 || i == i2 || i == i3) continue;
@@ -56,7 +67,8 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
   const FrameFeatures& lf = last.F();
   const Rigid3d& cam_from_world = *current.cam_from_world;
   // Moving forward, points grow in the image (appear on finer levels); backward, coarser.
-  const Eigen::Vector3d last_from_current_t = (*last.cam_from_world * cam_from_world.inverse()).translation();
+  const Eigen::Vector3d last_from_current_t =
+      (*last.cam_from_world * cam_from_world.inverse()).translation();
   const double baseline = cf.intrinsics.bf / cf.intrinsics.fx;
   const bool forward = last_from_current_t.z() > baseline;
   const bool backward = -last_from_current_t.z() > baseline;
@@ -88,7 +100,8 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
     for (size_t idx : candidates) {
       if (current.map_points[idx] && current.map_points[idx]->NumObservations() > 0) continue;
       if (cf.u_right[idx] > 0 && std::abs(ur - cf.u_right[idx]) > r) continue;
-      const int d = DescriptorDistance(point->descriptor, cf.descriptors.row(static_cast<int>(idx)));
+      const int d =
+          DescriptorDistance(point->descriptor, cf.descriptors.row(static_cast<int>(idx)));
       if (d < best_dist) {
         best_dist = d;
         best_idx = idx;
@@ -98,7 +111,8 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
       current.map_points[best_idx] = point;
       ++matches;
       if (check_orientation_) {
-        rotations.emplace_back(best_idx, AngleDiff(lf.keypoints[i].angle, cf.keypoints[best_idx].angle));
+        rotations.emplace_back(best_idx,
+                               AngleDiff(lf.keypoints[i].angle, cf.keypoints[best_idx].angle));
       }
     }
   }
@@ -112,7 +126,8 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
 }
 
 int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<MapPoint>>& points,
-                                const std::vector<ProjectionPrediction>& predictions, float radius) const {
+                                const std::vector<ProjectionPrediction>& predictions,
+                                float radius) const {
   const FrameFeatures& f = frame.F();
   int matches = 0;
   for (size_t k = 0; k < points.size(); ++k) {
@@ -126,7 +141,8 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
     size_t best_idx = 0;
     for (size_t idx : candidates) {
       if (frame.map_points[idx] && frame.map_points[idx]->NumObservations() > 0) continue;
-      if (f.u_right[idx] > 0 && std::abs(pred.u_right - f.u_right[idx]) > r * f.pyramid->scale_factors[level]) {
+      if (f.u_right[idx] > 0 &&
+          std::abs(pred.u_right - f.u_right[idx]) > r * f.pyramid->scale_factors[level]) {
         continue;
       }
       const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
@@ -150,7 +166,8 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
   return matches;
 }
 
-int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius, int max_distance) const {
+int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius,
+                                int max_distance) const {
   const FrameFeatures& f = frame.F();
   const Rigid3d& cam_from_world = *frame.cam_from_world;
   const Eigen::Vector3d center = frame.CameraCenter();
@@ -159,7 +176,9 @@ int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float ra
   for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
     const auto& point = keyframe.map_points[i];
     if (!point || point->bad) continue;
-    if (std::find(frame.map_points.begin(), frame.map_points.end(), point) != frame.map_points.end()) continue;
+    if (std::find(frame.map_points.begin(), frame.map_points.end(), point) !=
+        frame.map_points.end())
+      continue;
     const Eigen::Vector3d pc = cam_from_world * point->position;
     if (pc.z() <= 0) continue;
     const float u = static_cast<float>(f.intrinsics.fx * pc.x() / pc.z() + f.intrinsics.cx);
@@ -183,7 +202,8 @@ int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float ra
       frame.map_points[best_idx] = point;
       ++matches;
       if (check_orientation_) {
-        rotations.emplace_back(best_idx, AngleDiff(keyframe.F().keypoints[i].angle, f.keypoints[best_idx].angle));
+        rotations.emplace_back(
+            best_idx, AngleDiff(keyframe.F().keypoints[i].angle, f.keypoints[best_idx].angle));
       }
     }
   }
@@ -209,7 +229,8 @@ int Matcher::SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
 
   cv::Mat kf_descriptors(static_cast<int>(kf_indices.size()), 32, CV_8UC1);
   for (size_t k = 0; k < kf_indices.size(); ++k) {
-    kf.descriptors.row(static_cast<int>(kf_indices[k])).copyTo(kf_descriptors.row(static_cast<int>(k)));
+    kf.descriptors.row(static_cast<int>(kf_indices[k]))
+        .copyTo(kf_descriptors.row(static_cast<int>(k)));
   }
   // For every frame keypoint its two nearest keyframe keypoints (OpenCV's brute force).
   cv::BFMatcher bf(cv::NORM_HAMMING);
@@ -247,8 +268,8 @@ int Matcher::SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
   return n;
 }
 
-int Matcher::Fuse(Map& map, KeyFrame& keyframe, const std::vector<std::shared_ptr<MapPoint>>& points,
-                  float radius) const {
+int Matcher::Fuse(Map& map, KeyFrame& keyframe,
+                  const std::vector<std::shared_ptr<MapPoint>>& points, float radius) const {
   const FrameFeatures& f = keyframe.F();
   const Rigid3d& cam_from_world = keyframe.cam_from_world;
   const Eigen::Vector3d center = keyframe.CameraCenter();

@@ -19,7 +19,8 @@ class Matcher {
   static constexpr int kThLow = 50;
   static constexpr int kHistogramBins = 30;
 
-  Matcher(float nn_ratio, bool check_orientation) : nn_ratio_(nn_ratio), check_orientation_(check_orientation) {}
+  Matcher(float nn_ratio, bool check_orientation)
+      : nn_ratio_(nn_ratio), check_orientation_(check_orientation) {}
 
   // Constant-velocity tracking: map points of `last` projected into `current` (whose pose is
   // the prediction). Returns the number of new matches written into current.map_points.
@@ -30,7 +31,8 @@ class Matcher {
                          const std::vector<ProjectionPrediction>& predictions, float radius) const;
 
   // Relocalisation: map points of `keyframe` not yet in `found` projected into `frame`.
-  int SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius, int max_distance) const;
+  int SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius,
+                         int max_distance) const;
 
   // Descriptor matching (brute force, ratio test, rotation check) of the frame's keypoints
   // against the keyframe's keypoints that have map points: writes the matches into `matches`
@@ -49,7 +51,8 @@ class Matcher {
 
  private:
   // Indices of the matches to drop because their rotation is not among the 3 main bins.
-  static std::vector<size_t> RotationOutliers(const std::vector<std::pair<size_t, float>>& rotations);
+  static std::vector<size_t> RotationOutliers(
+      const std::vector<std::pair<size_t, float>>& rotations);
 
   float nn_ratio_;
   bool check_orientation_;

@@ -30,7 +30,8 @@ void CheckKnownKeys(const YAML::Node& node, const char* section,
     const std::string key = entry.first.as<std::string>();
     bool known = false;
     for (const char* k : keys) known = known || key == k;
-    if (!known) throw std::invalid_argument(std::string("unknown key '") + section + "." + key + "'");
+    if (!known)
+      throw std::invalid_argument(std::string("unknown key '") + section + "." + key + "'");
   }
 }
 
@@ -46,8 +47,8 @@ void FrameDepthOptions::Check() const {
 
 FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
   CheckKnownKeys(node, "depth",
-                 {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor",
-                  "edge_radius", "edge_relative_jump"});
+                 {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor", "edge_radius",
+                  "edge_relative_jump"});
   FrameDepthOptions o;
   Read(node, "min_depth", o.min_depth);
   Read(node, "max_depth", o.max_depth);
@@ -61,30 +62,34 @@ FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
 
 void TrackingOptions::Check() const {
   Require(min_init_points >= 10, "tracking: min_init_points must be >= 10");
-  Require(motion_search_radius > 0 && local_search_radius > 0, "tracking: search radii must be > 0");
+  Require(motion_search_radius > 0 && local_search_radius > 0,
+          "tracking: search radii must be > 0");
   Require(min_motion_matches > 0 && min_inliers > 0 && min_inliers_after_reloc > 0,
           "tracking: match thresholds must be > 0");
   Require(max_local_keyframes > 0, "tracking: max_local_keyframes must be > 0");
   Require(min_frames_between_keyframes >= 0 &&
               max_frames_between_keyframes >= min_frames_between_keyframes,
           "tracking: need 0 <= min_frames_between_keyframes <= max_frames_between_keyframes");
-  Require(keyframe_ref_ratio > 0 && keyframe_ref_ratio <= 1, "tracking: keyframe_ref_ratio in (0, 1]");
+  Require(keyframe_ref_ratio > 0 && keyframe_ref_ratio <= 1,
+          "tracking: keyframe_ref_ratio in (0, 1]");
   Require(close_tracked_min >= 0 && close_untracked_min >= 0 && new_keyframe_min_points >= 0,
           "tracking: close point counts must be >= 0");
-  Require(keyframe_ref_min_observations >= 0, "tracking: keyframe_ref_min_observations must be >= 0");
+  Require(keyframe_ref_min_observations >= 0,
+          "tracking: keyframe_ref_min_observations must be >= 0");
   Require(relocalisation_keyframes > 0, "tracking: relocalisation_keyframes must be > 0");
   Require(reinit_after_lost_frames >= 0, "tracking: reinit_after_lost_frames must be >= 0");
   Require(dynamic_cull_hits > 0, "tracking: dynamic_cull_hits must be > 0");
 }
 
 TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
-  CheckKnownKeys(node, "tracking",
-                 {"min_init_points", "motion_search_radius", "min_motion_matches",
-                  "local_search_radius", "min_inliers", "min_inliers_after_reloc",
-                  "max_local_keyframes", "min_frames_between_keyframes",
-                  "max_frames_between_keyframes", "keyframe_ref_ratio", "keyframe_ref_min_observations", "close_tracked_min",
-                  "close_untracked_min", "new_keyframe_min_points", "relocalisation_keyframes",
-                  "reinit_after_lost_frames", "dynamic_cull_hits"});
+  CheckKnownKeys(
+      node, "tracking",
+      {"min_init_points", "motion_search_radius", "min_motion_matches", "local_search_radius",
+       "min_inliers", "min_inliers_after_reloc", "max_local_keyframes",
+       "min_frames_between_keyframes", "max_frames_between_keyframes", "keyframe_ref_ratio",
+       "keyframe_ref_min_observations", "close_tracked_min", "close_untracked_min",
+       "new_keyframe_min_points", "relocalisation_keyframes", "reinit_after_lost_frames",
+       "dynamic_cull_hits"});
   TrackingOptions o;
   Read(node, "min_init_points", o.min_init_points);
   Read(node, "motion_search_radius", o.motion_search_radius);
@@ -109,6 +114,7 @@ TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
 
 void MappingOptions::Check() const {
   Require(cull_found_ratio >= 0 && cull_found_ratio < 1, "mapping: cull_found_ratio in [0, 1)");
+  Require(ba_max_keyframes >= 0, "mapping: ba_max_keyframes must be >= 0");
   Require(cull_min_observations >= 1, "mapping: cull_min_observations must be >= 1");
   Require(fuse_neighbours >= 0 && fuse_radius > 0, "mapping: fuse settings must be positive");
   Require(redundant_ratio > 0 && redundant_ratio <= 1, "mapping: redundant_ratio in (0, 1]");
@@ -119,8 +125,8 @@ void MappingOptions::Check() const {
 MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
   CheckKnownKeys(node, "mapping",
                  {"deterministic", "local_ba", "cull_found_ratio", "cull_min_observations",
-                  "fuse_neighbours", "fuse_radius", "redundant_ratio", "redundant_observers",
-                  "ba_first_iterations", "ba_second_iterations"});
+                  "fuse_neighbours", "fuse_radius", "ba_max_keyframes", "redundant_ratio",
+                  "redundant_observers", "ba_first_iterations", "ba_second_iterations"});
   MappingOptions o;
   Read(node, "deterministic", o.deterministic);
   Read(node, "local_ba", o.local_ba);
@@ -128,6 +134,7 @@ MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
   Read(node, "cull_min_observations", o.cull_min_observations);
   Read(node, "fuse_neighbours", o.fuse_neighbours);
   Read(node, "fuse_radius", o.fuse_radius);
+  Read(node, "ba_max_keyframes", o.ba_max_keyframes);
   Read(node, "redundant_ratio", o.redundant_ratio);
   Read(node, "redundant_observers", o.redundant_observers);
   Read(node, "ba_first_iterations", o.ba.first_iterations);
@@ -149,9 +156,9 @@ SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesys
   SystemOptions o;
   try {
     if (root && !root.IsNull() && !root.IsMap()) throw std::invalid_argument("root must be a map");
-    CheckKnownKeys(root, "(root)",
-                   {"camera", "orb", "filter", "depth", "tracking", "mapping", "optimizer",
-                    "detector"});
+    CheckKnownKeys(
+        root, "(root)",
+        {"camera", "orb", "filter", "depth", "tracking", "mapping", "optimizer", "detector"});
     if (root["orb"]) o.orb = OrbOptions::FromYaml(root["orb"]);
     if (root["filter"]) o.filter = FilterOptions::FromYaml(root["filter"]);
     o.depth = FrameDepthOptions::FromYaml(root["depth"]);

@@ -7,9 +7,9 @@
 // Absent keys keep their defaults; a key of the wrong type or a bad value is an InputError naming
 // the config file. Every field is documented in configs/7scenes.yaml and docs/slam.md.
 
-#include <filesystem>
-
 #include <yaml-cpp/yaml.h>
+
+#include <filesystem>
 
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
@@ -20,14 +20,14 @@ namespace ademono {
 
 // How per-keypoint depth is read from the depth map (`depth:` node).
 struct FrameDepthOptions {
-  double min_depth = 0.1;           // m; nearer readings are invalid
-  double max_depth = 10.0;          // m; farther readings are invalid (no depth residual)
-  double virtual_baseline = 0.08;   // m; bf = virtual_baseline * fx for the u_right residual
-  double close_depth_factor = 40.0; // ThDepth: points nearer than factor * baseline are "close"
+  double min_depth = 0.1;            // m; nearer readings are invalid
+  double max_depth = 10.0;           // m; farther readings are invalid (no depth residual)
+  double virtual_baseline = 0.08;    // m; bf = virtual_baseline * fx for the u_right residual
+  double close_depth_factor = 40.0;  // ThDepth: points nearer than factor * baseline are "close"
   // Depth discontinuities: a reading is dropped when the depth range in its
   // (2 * edge_radius + 1)^2 neighbourhood exceeds edge_relative_jump * depth. This matters for
   // unregistered depth (7-Scenes, raw Kinect), where edges are shifted against the colour image.
-  int edge_radius = 2;              // 0 disables the test
+  int edge_radius = 2;  // 0 disables the test
   double edge_relative_jump = 0.05;
   double CloseDepth() const { return close_depth_factor * virtual_baseline; }
   void Check() const;  // throws std::invalid_argument
@@ -35,16 +35,16 @@ struct FrameDepthOptions {
 };
 
 struct TrackingOptions {
-  int min_init_points = 500;          // points with depth needed to initialise the map
-  double motion_search_radius = 15;   // px at level 0 for the constant-velocity search
-  int min_motion_matches = 20;        // below this the window is doubled and searched again
-  double local_search_radius = 3;     // px at level 0 for the local-map search
-  int min_inliers = 30;               // inliers after local-map tracking to count as tracked
+  int min_init_points = 500;         // points with depth needed to initialise the map
+  double motion_search_radius = 15;  // px at level 0 for the constant-velocity search
+  int min_motion_matches = 20;       // below this the window is doubled and searched again
+  double local_search_radius = 3;    // px at level 0 for the local-map search
+  int min_inliers = 30;              // inliers after local-map tracking to count as tracked
   int min_inliers_after_reloc = 50;
   int max_local_keyframes = 80;
   int min_frames_between_keyframes = 0;
   int max_frames_between_keyframes = 30;  // about one second at 30 Hz
-  double keyframe_ref_ratio = 0.75;   // tracked/reference-keyframe point ratio for a new keyframe
+  double keyframe_ref_ratio = 0.75;  // tracked/reference-keyframe point ratio for a new keyframe
   // Reference-keyframe points count when seen by this many keyframes (0: ORB-SLAM's 2 or 3).
   int keyframe_ref_min_observations = 0;
   int close_tracked_min = 100;        // fewer tracked close points than this ...
@@ -62,12 +62,13 @@ struct MappingOptions {
   // false: in its own thread, concurrent with tracking (faster wall time, not reproducible).
   bool deterministic = true;
   bool local_ba = true;
-  double cull_found_ratio = 0.25;    // found / visible below this: point culled
-  int cull_min_observations = 2;     // fewer observations two keyframes after creation: culled
-  int fuse_neighbours = 10;          // covisible keyframes searched for duplicates
-  double fuse_radius = 3;            // px at level 0
-  double redundant_ratio = 0.9;      // keyframe culled when this fraction of its points ...
-  int redundant_observers = 3;       // ... is seen by this many other keyframes
+  int ba_max_keyframes = 0;        // free keyframes in the local BA (best covisibles); 0 = all
+  double cull_found_ratio = 0.25;  // found / visible below this: point culled
+  int cull_min_observations = 2;   // fewer observations two keyframes after creation: culled
+  int fuse_neighbours = 10;        // covisible keyframes searched for duplicates
+  double fuse_radius = 3;          // px at level 0
+  double redundant_ratio = 0.9;    // keyframe culled when this fraction of its points ...
+  int redundant_observers = 3;     // ... is seen by this many other keyframes
   BundleAdjustmentOptions ba;
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);

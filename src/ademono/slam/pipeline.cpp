@@ -16,7 +16,8 @@ struct Prepared {
 };
 
 double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {

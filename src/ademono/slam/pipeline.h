@@ -16,9 +16,9 @@
 namespace ademono {
 
 struct PipelineOptions {
-  size_t start = 0;               // first frame (inclusive)
-  size_t end = SIZE_MAX;          // last frame (exclusive), clamped to the sequence size
-  bool overlap = true;            // prefetch depth/detections of the next frame
+  size_t start = 0;       // first frame (inclusive)
+  size_t end = SIZE_MAX;  // last frame (exclusive), clamped to the sequence size
+  bool overlap = true;    // prefetch depth/detections of the next frame
   // Called after each frame (in order, on the calling thread).
   std::function<void(const FrameData&, const cv::Mat& depth, const std::vector<Detection>&,
                      const TrackResult&)>
@@ -31,8 +31,8 @@ struct FrameTiming {
 };
 
 struct PipelineResult {
-  std::vector<FrameTiming> timings;           // one per processed frame
-  std::vector<FrameData> ground_truth_frames; // index, timestamp and gt pose (images dropped)
+  std::vector<FrameTiming> timings;            // one per processed frame
+  std::vector<FrameData> ground_truth_frames;  // index, timestamp and gt pose (images dropped)
   size_t frames = 0;
   double wall_seconds = 0;
 };

@@ -3,14 +3,14 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-
 #include <opencv2/imgproc.hpp>
 
 namespace ademono {
 namespace {
 
 double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 }  // namespace
@@ -36,8 +36,8 @@ void System::Shutdown() {
   local_mapping_.Shutdown();
 }
 
-std::vector<float> System::KeypointDepths(const std::vector<cv::KeyPoint>& keypoints, const cv::Mat& depth,
-                                          const FrameDepthOptions& options) {
+std::vector<float> System::KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
+                                          const cv::Mat& depth, const FrameDepthOptions& options) {
   std::vector<float> result(keypoints.size(), -1.f);
   if (depth.empty()) return result;
   const int r = options.edge_radius;
@@ -126,9 +126,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   if (kept_descriptors.empty()) kept_descriptors = cv::Mat(0, 32, CV_8UC1);
 
   start = std::chrono::steady_clock::now();
-  auto features = MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
-                                    options_.depth.CloseDepth(), kept_keypoints, kept_descriptors,
-                                    kept_depths);
+  auto features =
+      MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
+                        options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths);
   TrackingOutput out;
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
@@ -170,7 +170,8 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   if (out.tracked) {
     const Rigid3d world_from_cam = out.cam_from_world.inverse();
     for (size_t i = 0; i < kept_keypoints.size(); ++i) {
-      if (features->depth[i] > 0) previous.points_world[i] = world_from_cam * features->UnprojectCamera(i);
+      if (features->depth[i] > 0)
+        previous.points_world[i] = world_from_cam * features->UnprojectCamera(i);
     }
   }
   previous_ = std::move(previous);
@@ -206,7 +207,8 @@ std::vector<System::ColoredPoint> System::MapPointCloud() const {
   for (const auto& [id, p] : map_.MapPoints()) {
     if (p->bad) continue;
     auto it = point_colors_.find(id);
-    cloud.push_back({p->position, it == point_colors_.end() ? cv::Vec3b(255, 255, 255) : it->second});
+    cloud.push_back(
+        {p->position, it == point_colors_.end() ? cv::Vec3b(255, 255, 255) : it->second});
   }
   return cloud;
 }

@@ -29,9 +29,9 @@ struct TrackResult {
   std::optional<Rigid3d> cam_from_world;
   TrackingState state = TrackingState::kNotInitialized;
   bool new_keyframe = false;
-  int num_keypoints = 0;  // extracted
-  int num_kept = 0;       // after the filters
-  int num_with_depth = 0; // kept keypoints with valid depth
+  int num_keypoints = 0;   // extracted
+  int num_kept = 0;        // after the filters
+  int num_with_depth = 0;  // kept keypoints with valid depth
   int inliers = 0;
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
@@ -69,8 +69,8 @@ class System {
   const SystemOptions& Options() const { return options_; }
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
-  static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints, const cv::Mat& depth,
-                                           const FrameDepthOptions& options);
+  static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
+                                           const cv::Mat& depth, const FrameDepthOptions& options);
 
  private:
   Camera camera_;

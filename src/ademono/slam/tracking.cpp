@@ -1,11 +1,11 @@
 #include "ademono/slam/tracking.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <map>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
-#include <spdlog/spdlog.h>
 
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
@@ -98,7 +98,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     if (out.relocalised) ++num_relocalisations_;
     last_good_pose_ = *frame.cam_from_world;
     record.reference = frame.reference_keyframe;
-    record.cam_from_reference = *frame.cam_from_world * frame.reference_keyframe->cam_from_world.inverse();
+    record.cam_from_reference =
+        *frame.cam_from_world * frame.reference_keyframe->cam_from_world.inverse();
     out.tracked = true;
     out.cam_from_world = *frame.cam_from_world;
     out.inliers = matches_inliers_;
@@ -282,7 +283,9 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
     const auto& classes = options_.filter.dynamic_class_ids;
     for (size_t k = 0; k < candidates.size(); ++k) {
       for (const Detection& d : detections) {
-        if (!classes.empty() && std::find(classes.begin(), classes.end(), d.class_id) == classes.end()) continue;
+        if (!classes.empty() &&
+            std::find(classes.begin(), classes.end(), d.class_id) == classes.end())
+          continue;
         if (d.box.contains(cv::Point2f(predictions[k].u, predictions[k].v))) {
           if (++candidates[k]->dynamic_hits >= options_.tracking.dynamic_cull_hits) {
             map_.ErasePoint(candidates[k].get());
@@ -294,7 +297,8 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
     }
   }
   const bool recently_relocalised = frame.id < last_reloc_frame_id_ + 2;
-  const float radius = static_cast<float>(options_.tracking.local_search_radius) * (recently_relocalised ? 1.7f : 1.f);
+  const float radius = static_cast<float>(options_.tracking.local_search_radius) *
+                       (recently_relocalised ? 1.7f : 1.f);
   const Matcher matcher(0.8f, false);
   matcher.SearchByProjection(frame, candidates, predictions, radius);
 
@@ -306,7 +310,8 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
     ++p->found;
     if (p->NumObservations() > 0) ++matches_inliers_;
   }
-  const uint64_t reloc_window = static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
+  const uint64_t reloc_window =
+      static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
   if (num_relocalisations_ > 0 && frame.id < last_reloc_frame_id_ + reloc_window &&
       matches_inliers_ < options_.tracking.min_inliers_after_reloc) {
     return false;
@@ -317,13 +322,15 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
 bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const TrackingOptions& t = options_.tracking;
   const uint64_t since_reloc = frame.id - last_reloc_frame_id_;
-  if (num_relocalisations_ > 0 && since_reloc < static_cast<uint64_t>(t.max_frames_between_keyframes) &&
+  if (num_relocalisations_ > 0 &&
+      since_reloc < static_cast<uint64_t>(t.max_frames_between_keyframes) &&
       map_.NumKeyFrames() > static_cast<size_t>(t.max_frames_between_keyframes)) {
     return false;
   }
   if (reference_keyframe_ == nullptr) return true;
   const int min_obs = t.keyframe_ref_min_observations > 0 ? t.keyframe_ref_min_observations
-                      : map_.NumKeyFrames() <= 2 ? 2 : 3;
+                      : map_.NumKeyFrames() <= 2          ? 2
+                                                          : 3;
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
 
@@ -337,16 +344,18 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
       ++untracked_close;
     }
   }
-  const bool need_close = tracked_close < t.close_tracked_min && untracked_close > t.close_untracked_min;
+  const bool need_close =
+      tracked_close < t.close_tracked_min && untracked_close > t.close_untracked_min;
   const double ratio = map_.NumKeyFrames() < 2 ? 0.4 : t.keyframe_ref_ratio;
   const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
   const bool c1a = since_kf >= static_cast<uint64_t>(t.max_frames_between_keyframes);
   const bool c1b = since_kf >= static_cast<uint64_t>(t.min_frames_between_keyframes) && idle;
   const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
-  spdlog::debug("frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
-                frame.index, matches_inliers_, ref_matches, tracked_close, untracked_close,
-                local_points_.size(), local_keyframes_.size());
+  spdlog::debug(
+      "frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
+      frame.index, matches_inliers_, ref_matches, tracked_close, untracked_close,
+      local_points_.size(), local_keyframes_.size());
   if (!((c1a || c1b || c1c) && c2)) return false;
   // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
   return idle || local_mapping_.QueueSize() < 3;
@@ -406,7 +415,8 @@ bool Tracking::Relocalise(Frame& frame) {
     for (size_t i = 0; i < matches.size(); ++i) {
       if (!matches[i]) continue;
       const Eigen::Vector3d& x = matches[i]->position;
-      object.emplace_back(static_cast<float>(x.x()), static_cast<float>(x.y()), static_cast<float>(x.z()));
+      object.emplace_back(static_cast<float>(x.x()), static_cast<float>(x.y()),
+                          static_cast<float>(x.z()));
       image.push_back(f.keypoints_un[i].pt);
       indices.push_back(i);
     }
@@ -423,7 +433,8 @@ bool Tracking::Relocalise(Frame& frame) {
     cv::cv2eigen(R, rotation);
     Rigid3d pose = Rigid3d::Identity();
     pose.linear() = rotation;
-    pose.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    pose.translation() =
+        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
     frame.cam_from_world = pose;
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
     for (int k : inliers) frame.map_points[indices[k]] = matches[indices[k]];

@@ -45,8 +45,8 @@ class Tracking {
  public:
   Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options);
 
-  TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index, double timestamp,
-                       const std::vector<Detection>& detections);
+  TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
+                       double timestamp, const std::vector<Detection>& detections);
 
   TrackingState State() const { return state_; }
   const std::vector<FrameRecord>& Records() const { return records_; }
