@@ -6,6 +6,7 @@
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 #include <set>
 #include <stdexcept>
 
@@ -217,6 +218,35 @@ TEST(DescriptorDistanceTest, CountsDifferingBits) {
   EXPECT_EQ(DescriptorDistance(a, b), 9);
   b.setTo(0xFF);
   EXPECT_EQ(DescriptorDistance(a, b), 256);
+}
+
+}  // namespace
+}  // namespace ademono
+
+namespace ademono {
+namespace {
+
+TEST(OrbExtractorTest, OddSizesAndRandomMasksStayInContract) {
+  const std::vector<cv::Size> sizes{{1, 1},    {38, 38},  {39, 39},  {40, 41},  {60, 45},
+                                    {45, 300}, {700, 40}, {97, 131}, {320, 240}};
+  cv::RNG rng(5);  // local generator: independent of other tests' use of cv::theRNG()
+  for (const cv::Size& size : sizes) {
+    cv::Mat image(size, CV_8UC1);
+    rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+    cv::Mat mask(size, CV_8UC1);
+    rng.fill(mask, cv::RNG::UNIFORM, 0, 2);
+    for (const cv::Mat& m : {cv::Mat(), mask}) {
+      const Features f = Extract(image, {}, m);
+      ASSERT_EQ(f.descriptors.rows, static_cast<int>(f.keypoints.size())) << size;
+      for (const auto& kp : f.keypoints) {
+        EXPECT_GE(kp.pt.x, 0.f);
+        EXPECT_GE(kp.pt.y, 0.f);
+        EXPECT_LT(kp.pt.x, size.width);
+        EXPECT_LT(kp.pt.y, size.height);
+      }
+      EXPECT_LE(f.keypoints.size(), 1010u);
+    }
+  }
 }
 
 }  // namespace
