@@ -13,7 +13,8 @@
 namespace {
 
 struct EvalArgs {
-  std::string gt, est, format = "tum", align = "se3", rpe_unit = "frames", kitti_align;
+  std::string gt, est, format = "tum", gt_format, est_format, align = "se3", rpe_unit = "frames",
+                       kitti_align;
   double max_diff = 0.01, rpe_delta = 1;
   bool rpe_pairs_from_reference = false, kitti_metrics = false;
   std::string json, plot;
@@ -21,10 +22,15 @@ struct EvalArgs {
 
 int RunEval(const EvalArgs& a) {
   using namespace ademono;
-  const TrajectoryFormat format = ParseTrajectoryFormat(a.format);
+  const TrajectoryFormat gt_format =
+      ParseTrajectoryFormat(a.gt_format.empty() ? a.format : a.gt_format);
+  const TrajectoryFormat est_format =
+      ParseTrajectoryFormat(a.est_format.empty() ? a.format : a.est_format);
   EvalOptions options;
   options.alignment = ParseAlignment(a.align);
-  options.associate_by_timestamp = format != TrajectoryFormat::kKitti;
+  // KITTI files carry no timestamps: match pose i to pose i as soon as one side is KITTI.
+  options.associate_by_timestamp =
+      gt_format != TrajectoryFormat::kKitti && est_format != TrajectoryFormat::kKitti;
   options.max_diff = a.max_diff;
   options.rpe_delta = a.rpe_delta;
   options.rpe_unit = ParseDeltaUnit(a.rpe_unit);
@@ -34,8 +40,8 @@ int RunEval(const EvalArgs& a) {
                                                   : ParseKittiAlignment(a.kitti_align);
   options.Check();
 
-  const PoseSeries gt = ReadPoseSeries(a.gt, format);
-  const PoseSeries est = ReadPoseSeries(a.est, format);
+  const PoseSeries gt = ReadPoseSeries(a.gt, gt_format);
+  const PoseSeries est = ReadPoseSeries(a.est, est_format);
   EvalResult result;
   try {
     result = EvaluateTrajectories(gt, est, options);
@@ -63,6 +69,10 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--format", args->format, "File format of both files")
           ->check(CLI::IsMember({"tum", "kitti", "euroc"}))
           ->capture_default_str();
+      app.add_option("--gt-format", args->gt_format, "Format of --gt (default: --format)")
+          ->check(CLI::IsMember({"tum", "kitti", "euroc"}));
+      app.add_option("--est-format", args->est_format, "Format of --est (default: --format)")
+          ->check(CLI::IsMember({"tum", "kitti", "euroc"}));
       app.add_option("--align", args->align, "Alignment of the estimate before APE")
           ->check(CLI::IsMember({"none", "se3", "sim3", "origin"}))
           ->capture_default_str();

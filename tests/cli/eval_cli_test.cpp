@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -114,6 +115,46 @@ TEST_F(EvalCliTest, KittiMetricsAndSim3Scale) {
   EXPECT_EQ(j["kitti"]["alignment"], "7dof");
   EXPECT_TRUE(j.contains("scale"));
   EXPECT_GT(j["scale"].get<double>(), 0.5);
+}
+
+TEST_F(EvalCliTest, MixedFormatsEurocGroundTruthAgainstTumEstimate) {
+  // The same five poses written as EuRoC CSV (ns) and as TUM (s): zero error with any alignment.
+  std::ofstream euroc(dir_ / "gt.csv");
+  std::ofstream tum(dir_ / "est.txt");
+  std::ofstream kitti(dir_ / "est.kitti");
+  euroc << "#timestamp [ns],p_x,p_y,p_z,q_w,q_x,q_y,q_z\n";
+  for (int i = 0; i < 5; ++i) {
+    const double x = 0.1 * i, y = 0.02 * i * i, z = 0.3 * (i % 2);
+    euroc << 1403636579763555584LL + i * 50000000LL << "," << x << "," << y << "," << z
+          << ",1,0,0,0\n";
+    tum << std::setprecision(17) << 1403636579.763555584 + 0.05 * i << " " << x << " " << y << " "
+        << z << " 0 0 0 1\n";
+    kitti << "1 0 0 " << x << " 0 1 0 " << y << " 0 0 1 " << z << "\n";
+  }
+  euroc.close();
+  tum.close();
+  kitti.close();
+  const fs::path json = dir_ / "mixed.json";
+  RunResult r =
+      Run("--gt " + (dir_ / "gt.csv").string() + " --gt-format euroc --est " +
+          (dir_ / "est.txt").string() + " --est-format tum --align none --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(Read(json));
+  EXPECT_EQ(j["matched_poses"], 5);
+  EXPECT_LT(j["ape"]["max"].get<double>(), 1e-6);
+  // A KITTI estimate has no timestamps: matched by index.
+  r = Run("--gt " + (dir_ / "gt.csv").string() + " --gt-format euroc --est " +
+          (dir_ / "est.kitti").string() + " --est-format kitti --align none --json " +
+          json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(Read(json));
+  EXPECT_EQ(j["matched_poses"], 5);
+  EXPECT_LT(j["ape"]["max"].get<double>(), 1e-9);
+  // RPE 10 frames on 5 poses: no pairs, said plainly.
+  r = Run("--gt " + (dir_ / "gt.csv").string() + " --gt-format euroc --est " +
+          (dir_ / "est.txt").string() + " --est-format tum --rpe-delta 10");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("no pose pairs this far apart"));
 }
 
 TEST_F(EvalCliTest, NoMatchingTimestampsNamesBothFiles) {

@@ -501,8 +501,12 @@ std::string FormatReport(const EvalResult& r) {
   std::snprintf(buf, sizeof(buf), "RPE (delta %g %s)", r.rpe_delta,
                 r.rpe_unit == DeltaUnit::kFrames ? "frames" : "m");
   out += std::string(buf) + "\n";
-  row("  translation", r.rpe_trans, "m");
-  row("  rotation", r.rpe_rot_deg, "deg");
+  if (r.rpe_trans.count == 0) {
+    out += "  no pose pairs this far apart\n";
+  } else {
+    row("  translation", r.rpe_trans, "m");
+    row("  rotation", r.rpe_rot_deg, "deg");
+  }
   if (r.kitti) {
     std::snprintf(buf, sizeof(buf),
                   "KITTI (%s): t_rel %.3f %%  r_rel %.3f deg/100m  ATE %.3f m  RPE %.3f m %.3f deg"
