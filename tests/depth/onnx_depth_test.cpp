@@ -166,6 +166,20 @@ TEST(OnnxDepthTest, DynamicSizeMultipleOfWithPadding) {
   ExpectAll(centred.DepthFromImage(Grey(90, 30, 51), MakeCamera(90, 30)), 2.0f);
 }
 
+TEST(OnnxDepthTest, DynamicSizeRoundedToMultipleWithoutPadding) {
+  // Depth Anything's resize: short side to 20, sides rounded to multiples of 14, no padding.
+  const auto spec =
+      WriteSpec("pad_none",
+                "input:\n  resize: multiple\n  side: short\n  side_length: 20\n"
+                "  multiple_of: 14\n  pad: none\n  interpolation: cubic\n  units: byte\n"
+                "  mean: 0\n  std: 25.5\noutput:\n  kind: metric\n");
+  auto provider = Load("depth_dynamic.onnx", spec);
+  cv::Size input, content;
+  provider.Spec().InputGeometry({64, 48}, &input, &content);
+  EXPECT_EQ(input, cv::Size(28, 28));  // 26.7 x 20 -> 28 x 28 (20 rounds down to 14 < 20: ceil)
+  ExpectAll(provider.DepthFromImage(Grey(64, 48, 51), MakeCamera(64, 48)), 2.0f);
+}
+
 TEST(OnnxDepthTest, CanonicalFocalScalesByFocalAtNetworkResolution) {
   // 128x96 -> 64x48 halves fx = 500 to 250: depth = y * 250 / 1000 = 2 * 0.25.
   const auto spec =
