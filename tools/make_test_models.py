@@ -10,6 +10,9 @@ compare against hand-computed values:
   depth_bad_output.onnx 1x3x48x64 -> 1x2x48x64  two channels: must be rejected at load
   det_yolov5.onnx       1x3x64x64 -> 1x4x13     constant YOLOv5 rows (8 classes)
   det_yolov8.onnx       1x3x64x64 -> 1x12x4     constant YOLOv8 columns (8 classes)
+  det_yolov8_probe.onnx 1x3x64x64 -> 1x5x1      one YOLOv8 box whose class-0 score is the mean of
+                                                input channel 0: checks colour order, /255 and
+                                                the letterbox padding value
 The detector heads ignore the image (0 * mean(input) is added so the input stays in the graph).
 
 Run with the system Python (python3-onnx): /usr/bin/python3 tools/make_test_models.py
@@ -76,6 +79,31 @@ def constant_head(name, values, out_name="output"):
     save(graph, name + ".onnx")
 
 
+def input_probe_head(name):
+    """YOLOv8 layout, one anchor: box (32, 32, 10, 10), class-0 score = mean of channel 0."""
+    box = numpy_helper.from_array(np.array([32, 32, 10, 10], dtype=np.float32).reshape(1, 4, 1),
+                                  "box")
+    shape = numpy_helper.from_array(np.array([1, 1, 1], dtype=np.int64), "score_shape")
+    starts = numpy_helper.from_array(np.array([0], dtype=np.int64), "starts")
+    ends = numpy_helper.from_array(np.array([1], dtype=np.int64), "ends")
+    axes = numpy_helper.from_array(np.array([1], dtype=np.int64), "axes")
+    nodes = [
+        helper.make_node("Constant", [], ["box"], value=box),
+        helper.make_node("Constant", [], ["score_shape"], value=shape),
+        helper.make_node("Constant", [], ["starts"], value=starts),
+        helper.make_node("Constant", [], ["ends"], value=ends),
+        helper.make_node("Constant", [], ["axes"], value=axes),
+        helper.make_node("Slice", ["image", "starts", "ends", "axes"], ["channel0"]),
+        helper.make_node("ReduceMean", ["channel0"], ["mean0"], keepdims=0),
+        helper.make_node("Reshape", ["mean0", "score_shape"], ["score"]),
+        helper.make_node("Concat", ["box", "score"], ["output0"], axis=1),
+    ]
+    graph = helper.make_graph(nodes, name, [image_input(64, 64)],
+                              [helper.make_tensor_value_info("output0", TensorProto.FLOAT,
+                                                             [1, 5, 1])])
+    save(graph, name + ".onnx")
+
+
 def one_hot(class_id, prob, num_classes=8, rest=0.05):
     probs = [rest] * num_classes
     probs[class_id] = prob
@@ -107,6 +135,7 @@ def main():
     # YOLOv8 has no objectness: class scores are obj * cls of the same rows, transposed.
     v8 = [box + [obj * p for p in probs] for box, obj, probs in DET_BOXES]
     constant_head("det_yolov8", [np.asarray(v8).T.tolist()], out_name="output0")
+    input_probe_head("det_yolov8_probe")
 
 
 if __name__ == "__main__":

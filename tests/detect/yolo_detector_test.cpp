@@ -83,6 +83,21 @@ INSTANTIATE_TEST_SUITE_P(Heads, ConstantHeadTest,
                          testing::Values(std::make_pair("det_yolov5.onnx", YoloArch::kYolov5),
                                          std::make_pair("det_yolov8.onnx", YoloArch::kYolov8)));
 
+TEST(YoloDetectorTest, Yolov5And8InputIsRgbOver255WithCentredGreyPadding) {
+  // The probe's class-0 score is the mean of network channel 0. A pure red 64x32 image fills the
+  // centre half of the 64x64 input; the rest is padding 114. With RGB / 255:
+  // 0.5 * 255/255 + 0.5 * 114/255. (BGR order would give 0.5 * 114/255 only.)
+  YoloDetector detector(kModels / "det_yolov8_probe.onnx", YoloArch::kYolov8, AllClasses());
+  const cv::Mat red(32, 64, CV_8UC3, cv::Scalar(0, 0, 255));
+  const auto detections = detector.DetectImage(red);
+  ASSERT_EQ(detections.size(), 1u);
+  EXPECT_NEAR(detections[0].score, 0.5f + 0.5f * 114.f / 255.f, 1e-5);
+  // Box (32, 32, 10, 10) in the input -> (27, 27)-(37, 37) -> minus 16 rows of top padding.
+  ExpectBox(detections[0], 0, detections[0].score, {27, 11, 10, 10});
+  const cv::Mat blue(32, 64, CV_8UC3, cv::Scalar(255, 0, 0));
+  ASSERT_EQ(detector.DetectImage(blue).size(), 0u);  // 0.22 < 0.3
+}
+
 TEST(YoloDecodeTest, YoloxGridStrideAndExpSizes) {
   // 64x64 input: 8x8 + 4x4 + 2x2 = 84 anchors, 2 classes.
   Tensor output;
