@@ -55,15 +55,21 @@ class RunCliTest : public ::testing::Test {
 };
 
 TEST_F(RunCliTest, WritesAllOutputsForASlice) {
-  const CommandResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
-                                 " --frames 0:30 --out " + out_.string());
+  const CommandResult r =
+      RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 0:30 --viz " +
+             (out_ / "viz").string() + " --out " + out_.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* name :
        {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out_ / name)) << name;
   }
+  int viz_images = 0;
+  for (const auto& entry : fs::directory_iterator(out_ / "viz"))
+    viz_images += entry.path().extension() == ".jpg";
+  EXPECT_EQ(viz_images, 30);
   const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
   EXPECT_EQ(summary["frames"], 30);
+  EXPECT_LT(summary["accuracy"]["ate_se3_rmse_m"].get<double>(), 0.03);
   EXPECT_EQ(summary["tracked"], 30);
   EXPECT_EQ(summary["lost"], 0);
   EXPECT_GE(summary["keyframes"].get<int>(), 1);
