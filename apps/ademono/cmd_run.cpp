@@ -22,8 +22,10 @@
 #include "ademono/depth/depth_factory.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/eval/trajectory_eval.h"
+#include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/slam/ablation.h"
 #include "ademono/slam/pipeline.h"
 #include "ademono/slam/system.h"
 #include "command.h"
@@ -138,36 +140,13 @@ void WritePly(const fs::path& path, const std::vector<System::ColoredPoint>& clo
   });
 }
 
-void WriteViz(const fs::path& dir, const FrameData& frame, const TrackResult& r) {
-  cv::Mat canvas;
-  if (frame.image.channels() == 1) {
-    cv::cvtColor(frame.image, canvas, cv::COLOR_GRAY2BGR);
-  } else {
-    canvas = frame.image.clone();
-  }
-  for (size_t i = 0; i < r.keypoints.size() && i < r.labels.size(); ++i) {
-    cv::Scalar color;
-    switch (r.labels[i]) {
-      case PointLabel::kKept:
-        color = {0, 255, 0};
-        break;
-      case PointLabel::kEnhancementDropped:
-        color = {160, 160, 160};
-        break;
-      case PointLabel::kDynamicSmallBox:
-      case PointLabel::kDynamicStage1:
-      case PointLabel::kDynamicStage2:
-        color = {0, 0, 255};
-        break;
-      case PointLabel::kDistantDropped:
-        color = {255, 0, 0};
-        break;
-    }
-    cv::circle(canvas, r.keypoints[i].pt, 3, color, 1, cv::LINE_AA);
-  }
+// The filter's view of the frame (boxes as the filter grew them, keypoints by label, legend).
+void WriteViz(const fs::path& dir, const FrameData& frame, const std::vector<Detection>& detections,
+              const TrackResult& r, const FilterOptions& filter) {
   std::ostringstream name;
   name << "frame-" << std::setw(6) << std::setfill('0') << frame.index << ".jpg";
-  WriteImageAtomic(dir / name.str(), canvas);
+  WriteImageAtomic(dir / name.str(),
+                   DrawFilterResult(frame.image, r.keypoints, r.labels, detections, filter));
 }
 
 nlohmann::json TimingJson(const std::vector<double>& values) {
@@ -263,11 +242,20 @@ int Run(const RunArgs& args) {
   const auto start_time = std::chrono::steady_clock::now();
   size_t done = 0;
   int lost_so_far = 0;
-  pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&, const std::vector<Detection>&,
-                          const TrackResult& r) {
+  // Filter counts per frame and in total (slam/ablation.h FilterTotals).
+  FilterTotals filter_totals;
+  nlohmann::json filter_per_frame = nlohmann::json::array();
+  if (!viz.empty()) fs::create_directories(viz);
+  pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&,
+                          const std::vector<Detection>& detections, const TrackResult& r) {
     ++done;
     if (!r.tracked && r.state != TrackingState::kNotInitialized) ++lost_so_far;
-    if (!viz.empty()) WriteViz(viz, frame, r);
+    filter_totals.Add(r.filter_stats, r.num_keypoints);
+    nlohmann::json counts = FilterStatsJson(r.filter_stats);
+    counts["frame"] = frame.index;
+    counts["keypoints"] = r.num_keypoints;
+    filter_per_frame.push_back(std::move(counts));
+    if (!viz.empty()) WriteViz(viz, frame, detections, r, options.filter);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     const double fps = seconds > 0 ? done / seconds : 0.0;
@@ -318,6 +306,8 @@ int Run(const RunArgs& args) {
   summary["filters"] = {{"enhancement", options.filter.enable_enhancement},
                         {"dynamic_removal", options.filter.enable_dynamic_removal},
                         {"distant", options.filter.enable_distant_filter}};
+  summary["filter_counts"] = filter_totals.ToJson();
+  summary["filter_counts_per_frame"] = std::move(filter_per_frame);
   summary["frames"] = result.frames;
   summary["tracked"] = trajectory.size();
   summary["untracked"] = result.frames - trajectory.size();

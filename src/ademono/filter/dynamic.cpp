@@ -157,6 +157,37 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
     if ((projected - observed).norm() > params.d_min_px)
       result.labels[i] = PointLabel::kDynamicStage2;
   }
+
+  // Box vote: a point without a match has no evidence of its own, but if enough of the matched
+  // points of its large box failed stage 1 or 2 the box holds a moving object, and the unmatched
+  // points (mostly on the object: its texture and silhouette change frame to frame) go with it.
+  // A static object's box (few failures) keeps its unmatched points.
+  if (params.box_vote_ratio <= 1.0) {
+    std::vector<char> moving_box(result.boxes.size(), 0);
+    for (size_t b = 0; b < result.boxes.size(); ++b) {
+      if (result.boxes[b].small) continue;
+      int judged = 0, dynamic = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (!active(i) || prev_of[i] < 0 || !InsideBox(result.boxes[b].box, kps[i].pt)) continue;
+        ++judged;
+        if (result.labels[i] == PointLabel::kDynamicStage1 ||
+            result.labels[i] == PointLabel::kDynamicStage2)
+          ++dynamic;
+      }
+      moving_box[b] = judged >= params.box_vote_min_matches &&
+                      dynamic >= params.box_vote_ratio * static_cast<double>(judged);
+    }
+    for (size_t i = 0; i < n; ++i) {
+      if (!active(i) || !in_large[i] || prev_of[i] >= 0 || result.labels[i] != PointLabel::kKept)
+        continue;
+      for (size_t b = 0; b < result.boxes.size(); ++b) {
+        if (moving_box[b] && InsideBox(result.boxes[b].box, kps[i].pt)) {
+          result.labels[i] = PointLabel::kDynamicBoxVote;
+          break;
+        }
+      }
+    }
+  }
   return result;
 }
 

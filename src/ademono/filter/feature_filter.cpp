@@ -44,6 +44,8 @@ const char* PointLabelName(PointLabel label) {
       return "dynamic_stage2";
     case PointLabel::kDistantDropped:
       return "distant_dropped";
+    case PointLabel::kDynamicBoxVote:
+      return "dynamic_box_vote";
   }
   return "unknown";
 }
@@ -70,6 +72,11 @@ void FilterOptions::Check() const {
           "d_dis_px must be > 0, got " + std::to_string(d_dis_px));
   Require(d_min_px > 0 && std::isfinite(d_min_px),
           "d_min_px must be > 0, got " + std::to_string(d_min_px));
+  Require(box_vote_ratio >= 0 && std::isfinite(box_vote_ratio),
+          "box_vote_ratio must be >= 0 (> 1 disables the vote), got " +
+              std::to_string(box_vote_ratio));
+  Require(box_vote_min_matches >= 1,
+          "box_vote_min_matches must be >= 1, got " + std::to_string(box_vote_min_matches));
   Require(z_th_m > 0 && std::isfinite(z_th_m), "z_th_m must be > 0, got " + std::to_string(z_th_m));
   Require(drop_probability >= 0 && drop_probability <= 1,
           "drop_probability must be in [0, 1], got " + std::to_string(drop_probability));
@@ -91,6 +98,8 @@ FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
   o.background_matches_t = ReadKey(node, "background_matches_t", o.background_matches_t);
   o.d_dis_px = ReadKey(node, "d_dis_px", o.d_dis_px);
   o.d_min_px = ReadKey(node, "d_min_px", o.d_min_px);
+  o.box_vote_ratio = ReadKey(node, "box_vote_ratio", o.box_vote_ratio);
+  o.box_vote_min_matches = ReadKey(node, "box_vote_min_matches", o.box_vote_min_matches);
   o.dynamic_class_ids = ReadKey(node, "dynamic_class_ids", o.dynamic_class_ids);
   o.z_th_m = ReadKey(node, "z_th_m", o.z_th_m);
   o.drop_probability = ReadKey(node, "drop_probability", o.drop_probability);
@@ -147,6 +156,8 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     params.background_matches_t = options_.background_matches_t;
     params.d_dis_px = options_.d_dis_px;
     params.d_min_px = options_.d_min_px;
+    params.box_vote_ratio = options_.box_vote_ratio;
+    params.box_vote_min_matches = options_.box_vote_min_matches;
     params.dynamic_class_ids = options_.dynamic_class_ids;
     DynamicInput dyn;
     dyn.keypoints = &kps;
@@ -163,8 +174,13 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
   }
 
   if (options_.enable_distant_filter && !depths.empty()) {
+    const std::vector<bool> active = kept_mask();
+    for (size_t i = 0; i < n; ++i) {
+      if (active[i] && std::isfinite(depths[i]) && depths[i] > options_.z_th_m)
+        ++s.distant_candidates;
+    }
     const std::vector<bool> drop =
-        DrawDistantDrops(depths, kept_mask(), options_.z_th_m, options_.drop_probability, rng_);
+        DrawDistantDrops(depths, active, options_.z_th_m, options_.drop_probability, rng_);
     for (size_t i = 0; i < n; ++i)
       if (drop[i]) labels[i] = PointLabel::kDistantDropped;
   }
@@ -188,6 +204,9 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
         break;
       case PointLabel::kDistantDropped:
         ++s.removed_distant;
+        break;
+      case PointLabel::kDynamicBoxVote:
+        ++s.removed_box_vote;
         break;
     }
   }

@@ -27,6 +27,7 @@ enum class PointLabel : uint8_t {
   kDynamicStage1,       // large box, displacement differs from background by > D_dis
   kDynamicStage2,       // large box, reprojection error under constant velocity > D_min
   kDistantDropped,      // deeper than Z_th and drawn for dropping
+  kDynamicBoxVote,      // large box, unmatched, in a box whose matched points mostly moved
 };
 const char* PointLabelName(PointLabel label);
 
@@ -46,6 +47,8 @@ struct FilterOptions {
   int background_matches_t = 20;       // t smallest-Hamming background matches
   double d_dis_px = 8.0;               // stage 1 threshold (pixels)
   double d_min_px = 4.0;               // stage 2 threshold (pixels)
+  double box_vote_ratio = 0.3;         // unmatched large-box points follow their box's verdict
+  int box_vote_min_matches = 5;        // (see filter/dynamic.h); box_vote_ratio > 1 disables
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
   // Distant filter.
   double z_th_m = 30.0;
@@ -81,7 +84,11 @@ struct FilterStats {
   int removed_small_box = 0;
   int removed_stage1 = 0;
   int removed_stage2 = 0;
+  int removed_box_vote = 0;
   int removed_distant = 0;
+  // Points that reached the distant filter with a known depth above z_th (its candidates):
+  // removed_distant / distant_candidates is the realised drop rate.
+  int distant_candidates = 0;
   int kept = 0;
 };
 

@@ -11,9 +11,10 @@
 namespace ademono {
 namespace {
 
-constexpr std::array<PointLabel, 6> kAllLabels{
+constexpr std::array<PointLabel, 7> kAllLabels{
     PointLabel::kKept,          PointLabel::kEnhancementDropped, PointLabel::kDynamicSmallBox,
-    PointLabel::kDynamicStage1, PointLabel::kDynamicStage2,      PointLabel::kDistantDropped};
+    PointLabel::kDynamicStage1, PointLabel::kDynamicStage2,      PointLabel::kDynamicBoxVote,
+    PointLabel::kDistantDropped};
 
 void DashedLine(cv::Mat& img, cv::Point2f a, cv::Point2f b, const cv::Scalar& color) {
   const double length = std::hypot(b.x - a.x, b.y - a.y);
@@ -42,6 +43,8 @@ cv::Scalar PointLabelColor(PointLabel label) {
       return {0, 0, 128};
     case PointLabel::kDistantDropped:
       return {150, 150, 150};
+    case PointLabel::kDynamicBoxVote:
+      return {255, 128, 0};
   }
   return {255, 255, 255};
 }

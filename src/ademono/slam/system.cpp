@@ -162,16 +162,20 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   if (!options_.mapping.deterministic) result.mapping_ms = local_mapping_.LastMilliseconds();
 
   // What the dynamic filter needs of this frame next time.
+  // All keypoints, not only the kept ones: a point on a moving person removed in this frame must
+  // still be matchable next frame, or it would come back as "unmatched, no evidence" and be kept.
   PreviousFrameFeatures previous;
-  previous.keypoints = kept_keypoints;
-  previous.descriptors = kept_descriptors;
+  previous.keypoints = keypoints;
+  previous.descriptors = descriptors.empty() ? cv::Mat(0, 32, CV_8UC1) : descriptors;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  previous.points_world.assign(kept_keypoints.size(), Eigen::Vector3d(nan, nan, nan));
+  previous.points_world.assign(keypoints.size(), Eigen::Vector3d(nan, nan, nan));
   if (out.tracked) {
     const Rigid3d world_from_cam = out.cam_from_world.inverse();
-    for (size_t i = 0; i < kept_keypoints.size(); ++i) {
-      if (features->depth[i] > 0)
-        previous.points_world[i] = world_from_cam * features->UnprojectCamera(i);
+    for (size_t i = 0; i < keypoints.size(); ++i) {
+      if (!(depths[i] > 0)) continue;
+      const Eigen::Vector2d un =
+          camera_.Undistort(Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y));
+      previous.points_world[i] = world_from_cam * camera_.Unproject(un, depths[i]);
     }
   }
   previous_ = std::move(previous);
