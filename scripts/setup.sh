@@ -1,20 +1,26 @@
 #!/usr/bin/env bash
 # Installs what ademono needs on Debian 12, only what is missing, then configures and builds.
-# Usage: scripts/setup.sh [--build-type Release|Debug|Asan] [--build-dir DIR] [--no-build]
+# Usage: scripts/setup.sh [--build-type Release|Debug|RelWithDebInfo] [--sanitize] [--build-dir DIR] [--no-build]
+#   --sanitize: AddressSanitizer + UndefinedBehaviorSanitizer build (default dir build/asan)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_type=Release
 build_dir=""
 do_build=1
+sanitize=OFF
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-type) build_type="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --no-build) do_build=0; shift ;;
+    --sanitize) sanitize=ON; shift ;;
     *) echo "setup.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
-[ -n "$build_dir" ] || build_dir="$here/build/$(echo "$build_type" | tr '[:upper:]' '[:lower:]')"
+if [ -z "$build_dir" ]; then
+  if [ "$sanitize" = ON ]; then build_dir="$here/build/asan"
+  else build_dir="$here/build/$(echo "$build_type" | tr '[:upper:]' '[:lower:]')"; fi
+fi
 
 apt_packages=(
   build-essential cmake ninja-build pkg-config ccache
@@ -54,7 +60,7 @@ fi
 if [ "$do_build" = 1 ]; then
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+  cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DADEMONO_SANITIZE="$sanitize" \
     -DONNXRUNTIME_ROOT="$ort_root" "${launcher[@]}" >/dev/null
   cmake --build "$build_dir" -j "$(nproc)"
 fi
