@@ -41,9 +41,16 @@ const Data& LoadData() {
 }
 
 ademono::SystemOptions BenchOptions() {
+  // The settings of configs/7scenes.yaml that differ from the defaults.
   ademono::SystemOptions options;
   options.depth.min_depth = 0.3;
   options.depth.max_depth = 6.0;
+  options.depth.virtual_baseline = 0.03;
+  options.depth.close_depth_factor = 107;
+  options.depth.edge_radius = 3;
+  options.depth.edge_relative_jump = 0.03;
+  options.tracking.close_tracked_min = 250;
+  options.mapping.ba_max_keyframes = 20;
   return options;
 }
 
