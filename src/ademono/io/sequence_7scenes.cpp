@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <charconv>
 #include <map>
-#include <regex>
+#include <optional>
+#include <string_view>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
@@ -66,20 +67,34 @@ Camera ReadIntrinsics(const fs::path& path) {
   return camera;
 }
 
+// "frame-000123.color.jpg" / ".png" -> 123; nullopt for any other name.
+std::optional<long> ColourFrameNumber(const std::string& name) {
+  static constexpr std::string_view kPrefix = "frame-";
+  if (name.rfind(kPrefix, 0) != 0) return std::nullopt;
+  const size_t digits_end = name.find('.', kPrefix.size());
+  if (digits_end == std::string::npos || digits_end == kPrefix.size()) return std::nullopt;
+  const std::string rest = name.substr(digits_end);
+  if (rest != ".color.jpg" && rest != ".color.png") return std::nullopt;
+  long number = 0;
+  const char* begin = name.data() + kPrefix.size();
+  const char* end = name.data() + digits_end;
+  const auto [ptr, ec] = std::from_chars(begin, end, number);
+  if (ec != std::errc() || ptr != end) return std::nullopt;
+  return number;
+}
+
 }  // namespace
 
 std::unique_ptr<Sequence> OpenSevenScenes(const fs::path& dir,
                                           const std::optional<fs::path>& camera_yaml) {
   RequireDirectory(dir);
-  static const std::regex kColor(R"(frame-(\d+)\.color\.(png|jpg))");
   std::map<long, fs::path> images;
   for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    if (!std::regex_match(name, m, kColor)) continue;
-    const long number = std::stol(m[1].str());
-    if (!images.emplace(number, entry.path()).second) {
-      ThrowInputError(entry.path(), "frame " + m[1].str() + " has more than one colour image");
+    const auto number = ColourFrameNumber(entry.path().filename().string());
+    if (!number) continue;
+    if (!images.emplace(*number, entry.path()).second) {
+      ThrowInputError(entry.path(),
+                      "frame " + std::to_string(*number) + " has more than one colour image");
     }
   }
 
