@@ -166,11 +166,25 @@ TEST(RemoveDynamicPointsTest, EveryBranchGetsItsLabel) {
                                          PointLabel::kDynamicStage1,
                                          PointLabel::kDynamicStage2,
                                          PointLabel::kKept,
-                                         PointLabel::kKept,
+                                         PointLabel::kDynamicBoxVote,
                                          PointLabel::kKept,
                                          PointLabel::kDynamicStage2};
   for (int i = 0; i < Scene::kCount; ++i)
     EXPECT_EQ(r.labels[i], expected[i]) << "point " << i << ": " << PointLabelName(r.labels[i]);
+}
+
+TEST(RemoveDynamicPointsTest, BoxVoteOnlyForBoxesWhoseMatchedPointsMoved) {
+  const Scene s;
+  DynamicParams p = Params();
+  // Disabled: the unmatched large-box point has no evidence of its own and is kept.
+  p.box_vote_ratio = 1.5;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[10], PointLabel::kKept);
+  // The box's matched points: 3 of 6 failed a stage; a box needing more keeps its point.
+  p.box_vote_ratio = 0.9;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[10], PointLabel::kKept);
+  p.box_vote_ratio = 0.3;
+  p.box_vote_min_matches = 100;  // too few matched points to judge the box
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[10], PointLabel::kKept);
 }
 
 TEST(RemoveDynamicPointsTest, LargerTIncludesTheOutlierInTheBackgroundMotion) {

@@ -24,7 +24,7 @@ struct DynamicParams {
   double d_min_px = 4.0;
   // Box vote for unmatched large-box points: a box is moving when at least this fraction of its
   // matched points (and at least box_vote_min_matches of them) failed stage 1 or 2. > 1 disables.
-  double box_vote_ratio = 0.3;
+  double box_vote_ratio = 0.15;
   int box_vote_min_matches = 5;
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
   // Frame-to-frame matching for stage 1 (not in FilterOptions: ORB-SLAM's usual values).

@@ -72,9 +72,9 @@ void FilterOptions::Check() const {
           "d_dis_px must be > 0, got " + std::to_string(d_dis_px));
   Require(d_min_px > 0 && std::isfinite(d_min_px),
           "d_min_px must be > 0, got " + std::to_string(d_min_px));
-  Require(box_vote_ratio >= 0 && std::isfinite(box_vote_ratio),
-          "box_vote_ratio must be >= 0 (> 1 disables the vote), got " +
-              std::to_string(box_vote_ratio));
+  Require(
+      box_vote_ratio >= 0 && std::isfinite(box_vote_ratio),
+      "box_vote_ratio must be >= 0 (> 1 disables the vote), got " + std::to_string(box_vote_ratio));
   Require(box_vote_min_matches >= 1,
           "box_vote_min_matches must be >= 1, got " + std::to_string(box_vote_min_matches));
   Require(z_th_m > 0 && std::isfinite(z_th_m), "z_th_m must be > 0, got " + std::to_string(z_th_m));

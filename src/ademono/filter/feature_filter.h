@@ -4,15 +4,15 @@
 // (3) distant-point filtering. Each can be switched off (the paper's ablation).
 // Keypoints labelled anything but kKept are never used for pose estimation or as map points.
 
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
@@ -47,7 +47,7 @@ struct FilterOptions {
   int background_matches_t = 20;       // t smallest-Hamming background matches
   double d_dis_px = 8.0;               // stage 1 threshold (pixels)
   double d_min_px = 4.0;               // stage 2 threshold (pixels)
-  double box_vote_ratio = 0.3;         // unmatched large-box points follow their box's verdict
+  double box_vote_ratio = 0.15;        // unmatched large-box points follow their box's verdict
   int box_vote_min_matches = 5;        // (see filter/dynamic.h); box_vote_ratio > 1 disables
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
   // Distant filter.
@@ -55,7 +55,7 @@ struct FilterOptions {
   double drop_probability = 0.5;
   uint64_t seed = 42;
 
-  void Check() const;  // throws std::invalid_argument
+  void Check() const;                                     // throws std::invalid_argument
   static FilterOptions FromYaml(const YAML::Node& node);  // the `filter:` sub-node
 };
 
@@ -73,8 +73,8 @@ struct FilterInput {
   const cv::Mat* descriptors = nullptr;
   const std::vector<float>* depths = nullptr;  // metres per keypoint, <= 0 when unknown
   const std::vector<Detection>* detections = nullptr;
-  const PreviousFrameFeatures* previous = nullptr;         // null on the first frame
-  std::optional<Rigid3d> predicted_cam_from_world;          // constant-velocity prediction
+  const PreviousFrameFeatures* previous = nullptr;  // null on the first frame
+  std::optional<Rigid3d> predicted_cam_from_world;  // constant-velocity prediction
 };
 
 struct FilterStats {
