@@ -75,6 +75,34 @@ std::vector<float> System::KeypointDepths(const std::vector<cv::KeyPoint>& keypo
   return result;
 }
 
+int System::CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::Mat& depth,
+                                       const std::vector<Detection>& moving_boxes) {
+  // A map point on a moving object is left behind when the object moves on: it projects into the
+  // object's box but clearly in front of the surface now visible there. Static points are the
+  // visible surface (background in the box) or hidden behind the object; counting every point in
+  // a box instead wipes the background around a crossing person out of the map.
+  std::vector<MapPoint*> cull;
+  for (const auto& [id, p] : map_.MapPoints()) {
+    if (p->bad) continue;
+    const Eigen::Vector3d cam = cam_from_world * p->position;
+    if (!(cam.z() > 0)) continue;
+    const Eigen::Vector2d uv = camera_.Project(cam);
+    const int x = static_cast<int>(std::lround(uv.x())), y = static_cast<int>(std::lround(uv.y()));
+    if (x < 0 || y < 0 || x >= depth.cols || y >= depth.rows) continue;
+    const cv::Point2f pt(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
+    bool in_box = false;
+    for (const Detection& d : moving_boxes) in_box = in_box || d.box.contains(pt);
+    if (!in_box) continue;
+    // Only a point floating in front of the visible surface has left: a static point is the
+    // surface (depth agrees) or hidden behind the moving object (depth nearer).
+    const float z = depth.at<float>(y, x);
+    if (!(z > 0) || !std::isfinite(z) || z < 1.1 * cam.z()) continue;
+    if (++p->dynamic_hits >= options_.tracking.dynamic_cull_hits) cull.push_back(p.get());
+  }
+  for (MapPoint* p : cull) map_.ErasePoint(p);
+  return static_cast<int>(cull.size());
+}
+
 TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
                                const std::vector<Detection>& detections) {
   TrackResult result;
@@ -129,10 +157,33 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   auto features =
       MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
                         options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths);
+  // Map points are culled when they keep landing in dynamic boxes; only boxes the filter found
+  // to hold a moving object count, so a static person's (or parked car's) points survive.
+  std::vector<Detection> moving_detections;
+  for (const Detection& d : detections) {
+    int judged = 0, dynamic = 0;
+    for (size_t i = 0; i < keypoints.size(); ++i) {
+      if (labels[i] == PointLabel::kEnhancementDropped || !d.box.contains(keypoints[i].pt))
+        continue;
+      ++judged;
+      dynamic += labels[i] == PointLabel::kDynamicSmallBox ||
+                 labels[i] == PointLabel::kDynamicStage1 ||
+                 labels[i] == PointLabel::kDynamicStage2 ||
+                 labels[i] == PointLabel::kDynamicBoxVote;
+    }
+    if (judged > 0 && dynamic >= options_.filter.box_vote_ratio * judged)
+      moving_detections.push_back(d);
+  }
   TrackingOutput out;
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
-    out = tracking_.Track(features, frame.index, frame.timestamp, detections);
+    // With a depth map the occlusion-aware culling below replaces the tracker's box culling.
+    out = tracking_.Track(features, frame.index, frame.timestamp,
+                          depth.empty() ? moving_detections : std::vector<Detection>{});
+    if (out.tracked && !depth.empty() && options_.filter.enable_dynamic_removal &&
+        !moving_detections.empty())
+      out.dynamic_points_culled +=
+          CullPointsOnMovingObjects(out.cam_from_world, depth, moving_detections);
     result.state = tracking_.State();
     if (out.new_keyframe && !frame.image.empty()) {
       // Remember colours of the points this keyframe created.
@@ -151,6 +202,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   result.tracked = out.tracked;
   result.inliers = out.inliers;
+  result.dynamic_points_culled = out.dynamic_points_culled;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
 
   if (out.new_keyframe) {

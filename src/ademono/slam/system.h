@@ -33,6 +33,7 @@ struct TrackResult {
   int num_kept = 0;        // after the filters
   int num_with_depth = 0;  // kept keypoints with valid depth
   int inliers = 0;
+  int dynamic_points_culled = 0;  // map points culled for sitting in dynamic boxes
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)
@@ -73,6 +74,11 @@ class System {
                                            const cv::Mat& depth, const FrameDepthOptions& options);
 
  private:
+  // Counts hits of map points landing on moving objects (map_.mutex held) and erases those with
+  // tracking.dynamic_cull_hits of them; returns how many were erased.
+  int CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::Mat& depth,
+                                 const std::vector<Detection>& moving_boxes);
+
   Camera camera_;
   SystemOptions options_;
   OrbExtractor extractor_;
