@@ -1,0 +1,140 @@
+// End-to-end test of `ademono ablate` on a tiny synthetic office (20 frames with walking persons
+// and ground-truth boxes): five variant folders with run outputs, the table's columns, truth
+// scoring, filter counts in `run`'s summary.json and --viz images; bad input gives one line and
+// exit code 2 with no output left.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using ::testing::HasSubstr;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string Read(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class AblateCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("ademono_ablate_cli_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const RunResult r =
+        Run("synth --scene office --motion xyz --persons 2 --frames 20 --seed 3 "
+            "--out " +
+            (dir_ / "office").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  static RunResult Run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(ADEMONO_CLI) + " --log-level warn " + args + " >" +
+                            out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = Read(out);
+    r.err = Read(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+  static std::string Sequence() { return (dir_ / "office").string(); }
+
+  static fs::path dir_;
+};
+fs::path AblateCliTest::dir_;
+
+TEST_F(AblateCliTest, FiveVariantsAndTable) {
+  const fs::path out = dir_ / "ablate";
+  const RunResult r = Run("ablate --dataset tum:" + Sequence() +
+                          " --depth simulated --detector cache:" + Sequence() +
+                          "/detections.jsonl --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* v :
+       {"full", "no_dynamic", "no_distant", "no_dynamic_no_distant", "no_enhancement"}) {
+    EXPECT_THAT(r.out, HasSubstr(std::string("| ") + v + " |"));
+    for (const char* f : {"trajectory.tum", "keyframes.tum", "summary.json"})
+      EXPECT_TRUE(fs::exists(out / v / f)) << v << "/" << f;
+  }
+  const std::string md = Read(out / "ablation.md");
+  EXPECT_EQ(md, r.out);
+  for (const char* column :
+       {"ATE se3 (m)", "ATE sim3 (m)", "tracked", "keyframes", "removed enh", "removed dyn",
+        "removed distant", "moving removed", "static person removed"})
+    EXPECT_THAT(md, HasSubstr(column));
+  std::ifstream in(out / "ablation.json");
+  const nlohmann::json json = nlohmann::json::parse(in);
+  ASSERT_EQ(json["variants"].size(), 5u);
+  for (const auto& v : json["variants"]) {
+    EXPECT_EQ(v["frames"], 20);
+    EXPECT_TRUE(v["ate_se3_rmse_m"].is_number()) << v["variant"];
+    EXPECT_TRUE(v["truth"].is_object()) << v["variant"];
+    const bool dynamic = v["filters"]["dynamic_removal"].get<bool>();
+    EXPECT_EQ(v["filter_counts"]["removed_dynamic"].get<long long>() > 0, dynamic) << v["variant"];
+    EXPECT_EQ(v["filter_counts"]["removed_enhancement"].get<long long>() > 0,
+              v["filters"]["enhancement"].get<bool>())
+        << v["variant"];
+  }
+}
+
+TEST_F(AblateCliTest, RunSummaryCountsFiltersAndVizWritesOneImagePerFrame) {
+  const fs::path out = dir_ / "run", viz = dir_ / "viz";
+  const RunResult r =
+      Run("run --dataset tum:" + Sequence() + " --depth simulated --detector cache:" + Sequence() +
+          "/detections.jsonl --frames 0:6 --viz " + viz.string() + " --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  const auto& total = summary["filter_counts"];
+  const auto& frames = summary["filter_counts_per_frame"];
+  ASSERT_EQ(frames.size(), 6u);
+  long long removed_dynamic = 0, boxes = 0;
+  for (const auto& f : frames) {
+    removed_dynamic += f["removed_small_box"].get<long long>() +
+                       f["removed_stage1"].get<long long>() + f["removed_stage2"].get<long long>() +
+                       f["removed_box_vote"].get<long long>();
+    boxes += f["boxes_small"].get<long long>() + f["boxes_large"].get<long long>();
+  }
+  EXPECT_EQ(total["removed_dynamic"].get<long long>(), removed_dynamic);
+  EXPECT_EQ(total["boxes_small"].get<long long>() + total["boxes_large"].get<long long>(), boxes);
+  EXPECT_GT(boxes, 0);
+  size_t images = 0;
+  for (const auto& e : fs::directory_iterator(viz)) images += e.path().extension() == ".jpg";
+  EXPECT_EQ(images, 6u);
+}
+
+TEST_F(AblateCliTest, BadInputGivesOneLineAndNoOutput) {
+  const fs::path out = dir_ / "bad";
+  RunResult r =
+      Run("ablate --dataset tum:" + (dir_ / "missing").string() + " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("ademono ablate: error:"));
+  EXPECT_FALSE(fs::exists(out));
+  r = Run("ablate --dataset tum:" + Sequence() + " --variants full,bogus --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("unknown variant 'bogus'"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace

@@ -1,0 +1,179 @@
+// The ablation library: variants on a short 7-Scenes slice (outputs, ATE, filter counts that
+// follow the switches), a sequence without ground truth (ATE null with a note), and the
+// synthetic-truth scoring of keypoint labels against a moving-object mask.
+#include "ademono/slam/ablation.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "ademono/core/error.h"
+#include "ademono/depth/depth_factory.h"
+#include "slam_test_util.h"
+
+namespace fs = std::filesystem;
+
+namespace ademono {
+namespace {
+
+using testing_util::Slice;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_ablation_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+AblationOptions SliceOptions() {
+  AblationOptions options;
+  options.system.depth.min_depth = 0.3;
+  options.system.depth.max_depth = 6.0;
+  return options;
+}
+
+// Drops the ground truth of a sequence.
+class NoGroundTruth : public Sequence {
+ public:
+  explicit NoGroundTruth(std::unique_ptr<Sequence> base) : base_(std::move(base)) {}
+  std::string Kind() const override { return base_->Kind(); }
+  fs::path Path() const override { return base_->Path(); }
+  size_t Size() const override { return base_->Size(); }
+  const Camera& GetCamera() const override { return base_->GetCamera(); }
+  bool HasDepth() const override { return true; }
+  bool HasGroundTruth() const override { return false; }
+  double Timestamp(size_t i) const override { return base_->Timestamp(i); }
+  FrameData Load(size_t i) const override {
+    FrameData f = base_->Load(i);
+    f.world_from_cam_gt.reset();
+    return f;
+  }
+
+ private:
+  std::unique_ptr<Sequence> base_;
+};
+
+TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
+  const auto sequence = Slice(0, 15);
+  DepthFactoryContext context;
+  context.sequence = sequence.get();
+  auto depth = MakeDepthProvider("sensor", context);
+  // A person box over the right half from frame 5 on: the dynamic filter has work to do.
+  class HalfBox : public Detector {
+   public:
+    std::string Name() const override { return "half-box"; }
+    std::vector<Detection> Detect(const FrameData& frame) override {
+      if (frame.index < 5) return {};
+      Detection d;
+      d.class_id = 0;
+      d.score = 1.f;
+      d.box = cv::Rect2f(320, 0, 320, 480);
+      return {d};
+    }
+  } detector;
+  AblationOptions options = SliceOptions();
+  options.variants = {DefaultAblationVariants()[0], DefaultAblationVariants()[1]};
+  const fs::path out = TempDir("variants");
+  const std::vector<VariantResult> results =
+      RunAblation(*sequence, depth.get(), &detector, options, out);
+  ASSERT_EQ(results.size(), 2u);
+  for (const VariantResult& r : results) {
+    for (const char* file : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "summary.json"})
+      EXPECT_TRUE(fs::exists(out / r.variant.name / file)) << r.variant.name << " " << file;
+    EXPECT_EQ(r.frames, 15u);
+    EXPECT_EQ(r.tracked, 15u);
+    ASSERT_TRUE(r.ate_se3_m.has_value());
+    EXPECT_LT(*r.ate_se3_m, 0.05);
+    EXPECT_TRUE(r.ate_sim3_m.has_value());
+    EXPECT_TRUE(r.note.empty());
+    EXPECT_FALSE(r.truth.has_value());           // no masks/ in 7-Scenes
+    EXPECT_EQ(r.filters.distant_candidates, 0);  // all depth < 6 m
+    EXPECT_GT(r.filters.removed_enhancement, 0);
+  }
+  EXPECT_EQ(results[0].variant.name, "full");
+  EXPECT_EQ(results[0].filters.boxes_large, 10);
+  EXPECT_GT(results[0].filters.RemovedDynamic(), 0);
+  EXPECT_EQ(results[1].filters.RemovedDynamic(), 0);
+  EXPECT_EQ(results[1].filters.boxes_large, 0);
+
+  const std::string md = AblationMarkdown(results);
+  EXPECT_NE(md.find("| variant | enh | dyn | dist | ATE se3 (m) | ATE sim3 (m) | tracked |"),
+            std::string::npos);
+  EXPECT_NE(md.find("| full | on | on | on |"), std::string::npos);
+  EXPECT_NE(md.find("| no_dynamic | on | off | on |"), std::string::npos);
+  std::ifstream json_file(out / "ablation.json");
+  const nlohmann::json json = nlohmann::json::parse(json_file);
+  ASSERT_EQ(json["variants"].size(), 2u);
+  EXPECT_EQ(json["variants"][1]["variant"], "no_dynamic");
+  EXPECT_EQ(json["variants"][0]["filter_counts"]["removed_dynamic"].get<long long>(),
+            results[0].filters.RemovedDynamic());
+  EXPECT_TRUE(fs::exists(out / "ablation.md"));
+  std::ifstream summary_file(out / "full" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["per_frame"].size(), 15u);
+  fs::remove_all(out);
+}
+
+TEST(AblationTest, WithoutGroundTruthAteIsNullWithANote) {
+  const NoGroundTruth sequence(Slice(0, 8));
+  DepthFactoryContext context;
+  auto depth = MakeDepthProvider("sensor", context);
+  AblationOptions options = SliceOptions();
+  const fs::path out = TempDir("nogt");
+  const VariantResult r = RunAblationVariant(sequence, depth.get(), nullptr, options,
+                                             DefaultAblationVariants()[0], out / "full");
+  EXPECT_FALSE(r.ate_se3_m.has_value());
+  EXPECT_EQ(r.note, "dataset has no ground truth");
+  EXPECT_TRUE(r.ToJson()["ate_se3_rmse_m"].is_null());
+  EXPECT_NE(AblationMarkdown({r}).find("n/a"), std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST(AblationTest, DefaultVariantsAreTheFivePaperVariants) {
+  const auto& v = DefaultAblationVariants();
+  ASSERT_EQ(v.size(), 5u);
+  EXPECT_EQ(v[0].name, "full");
+  EXPECT_TRUE(v[0].enhancement && v[0].dynamic_removal && v[0].distant_filter);
+  EXPECT_FALSE(v[3].dynamic_removal || v[3].distant_filter);
+  EXPECT_FALSE(v[4].enhancement);
+  EXPECT_TRUE(v[4].dynamic_removal && v[4].distant_filter);
+}
+
+TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
+  const fs::path dir = TempDir("truth");
+  fs::create_directories(dir / "masks");
+  cv::Mat mask(100, 200, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 50, 100)).setTo(255);  // a moving object on the left
+  cv::imwrite((dir / "masks" / "f0.png").string(), mask);
+  const SyntheticTruth truth(dir);
+  ASSERT_TRUE(truth.Available());
+  FrameData frame;
+  frame.name = "f0";
+  frame.image = cv::Mat(100, 200, CV_8UC3, cv::Scalar::all(0));
+  Detection moving, standing;
+  moving.class_id = standing.class_id = 0;
+  moving.box = cv::Rect2f(0, 0, 50, 100);
+  standing.box = cv::Rect2f(120, 10, 40, 80);  // no moving pixels: the static person
+  const std::vector<cv::KeyPoint> kps{{10, 10, 7},  {20, 50, 7},  {30, 80, 7},
+                                      {130, 20, 7}, {140, 50, 7}, {90, 50, 7}};
+  const std::vector<PointLabel> labels{PointLabel::kDynamicStage1,      PointLabel::kKept,
+                                       PointLabel::kEnhancementDropped, PointLabel::kKept,
+                                       PointLabel::kDynamicBoxVote,     PointLabel::kKept};
+  TruthCounts counts;
+  truth.Score(frame, {moving, standing}, kps, labels, &counts);
+  EXPECT_EQ(counts.moving_keypoints, 2);  // the enhancement-dropped one does not count
+  EXPECT_EQ(counts.moving_removed, 1);
+  EXPECT_EQ(counts.moving_kept, 1);
+  EXPECT_EQ(counts.static_person_keypoints, 2);
+  EXPECT_EQ(counts.static_person_removed, 1);
+
+  frame.name = "missing";
+  EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);
+  EXPECT_FALSE(SyntheticTruth(dir / "nothing").Available());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ademono
