@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ademono/core/yaml_util.h"
+
 namespace ademono {
 namespace {
 
@@ -15,19 +17,6 @@ constexpr int kHalfPatchSize = 15;
 // Pixels kept clear of the level border: FAST needs 3, the rotated BRIEF pattern ~19.
 constexpr int kEdgeThreshold = 19;
 constexpr int kCellSize = 30;
-
-template <typename T>
-T ReadKey(const YAML::Node& node, const char* key, T fallback) {
-  const YAML::Node value = node[key];
-  if (!value) return fallback;
-  try {
-    return value.as<T>();
-  } catch (const YAML::Exception&) {
-    throw std::invalid_argument(std::string("orb.") + key + ": cannot parse '" +
-                                (value.IsScalar() ? value.Scalar() : std::string("<non-scalar>")) +
-                                "'");
-  }
-}
 
 // Horizontal half-extent of the circular orientation patch for each row offset 0..15 (the
 // circle is made exactly symmetric, as ORB does, so the centroid is unbiased).
@@ -216,12 +205,13 @@ OrbOptions OrbOptions::FromYaml(const YAML::Node& node) {
   OrbOptions options;
   if (!node || node.IsNull()) return options;
   if (!node.IsMap()) throw std::invalid_argument("orb: expected a map of options");
-  options.num_features = ReadKey(node, "num_features", options.num_features);
-  options.scale_factor = ReadKey(node, "scale_factor", options.scale_factor);
-  options.num_levels = ReadKey(node, "num_levels", options.num_levels);
+  options.num_features = ReadYamlKey(node, "orb", "num_features", options.num_features);
+  options.scale_factor = ReadYamlKey(node, "orb", "scale_factor", options.scale_factor);
+  options.num_levels = ReadYamlKey(node, "orb", "num_levels", options.num_levels);
   options.initial_fast_threshold =
-      ReadKey(node, "initial_fast_threshold", options.initial_fast_threshold);
-  options.min_fast_threshold = ReadKey(node, "min_fast_threshold", options.min_fast_threshold);
+      ReadYamlKey(node, "orb", "initial_fast_threshold", options.initial_fast_threshold);
+  options.min_fast_threshold =
+      ReadYamlKey(node, "orb", "min_fast_threshold", options.min_fast_threshold);
   options.Check();
   return options;
 }

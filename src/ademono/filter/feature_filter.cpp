@@ -4,25 +4,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "ademono/core/yaml_util.h"
 #include "ademono/filter/distant.h"
 #include "ademono/filter/dynamic.h"
 #include "ademono/filter/enhancement.h"
 
 namespace ademono {
 namespace {
-
-template <typename T>
-T ReadKey(const YAML::Node& node, const char* key, T fallback) {
-  const YAML::Node value = node[key];
-  if (!value) return fallback;
-  try {
-    return value.as<T>();
-  } catch (const YAML::Exception&) {
-    throw std::invalid_argument(std::string("filter.") + key + ": cannot parse '" +
-                                (value.IsScalar() ? value.Scalar() : std::string("<non-scalar>")) +
-                                "'");
-  }
-}
 
 void Require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("filter." + message);
@@ -86,24 +74,32 @@ FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
   FilterOptions o;
   if (!node || node.IsNull()) return o;
   if (!node.IsMap()) throw std::invalid_argument("filter: expected a map of options");
-  o.enable_enhancement = ReadKey(node, "enable_enhancement", o.enable_enhancement);
-  o.enable_dynamic_removal = ReadKey(node, "enable_dynamic_removal", o.enable_dynamic_removal);
-  o.enable_distant_filter = ReadKey(node, "enable_distant_filter", o.enable_distant_filter);
-  o.enhancement_keep_ratio = ReadKey(node, "enhancement_keep_ratio", o.enhancement_keep_ratio);
-  o.enhancement_levels = ReadKey(node, "enhancement_levels", o.enhancement_levels);
-  o.enhancement_p_percent = ReadKey(node, "enhancement_p_percent", o.enhancement_p_percent);
-  o.enhancement_q_percent = ReadKey(node, "enhancement_q_percent", o.enhancement_q_percent);
-  o.box_growth = ReadKey(node, "box_growth", o.box_growth);
-  o.small_box_area_ratio = ReadKey(node, "small_box_area_ratio", o.small_box_area_ratio);
-  o.background_matches_t = ReadKey(node, "background_matches_t", o.background_matches_t);
-  o.d_dis_px = ReadKey(node, "d_dis_px", o.d_dis_px);
-  o.d_min_px = ReadKey(node, "d_min_px", o.d_min_px);
-  o.box_vote_ratio = ReadKey(node, "box_vote_ratio", o.box_vote_ratio);
-  o.box_vote_min_matches = ReadKey(node, "box_vote_min_matches", o.box_vote_min_matches);
-  o.dynamic_class_ids = ReadKey(node, "dynamic_class_ids", o.dynamic_class_ids);
-  o.z_th_m = ReadKey(node, "z_th_m", o.z_th_m);
-  o.drop_probability = ReadKey(node, "drop_probability", o.drop_probability);
-  o.seed = ReadKey(node, "seed", o.seed);
+  o.enable_enhancement = ReadYamlKey(node, "filter", "enable_enhancement", o.enable_enhancement);
+  o.enable_dynamic_removal =
+      ReadYamlKey(node, "filter", "enable_dynamic_removal", o.enable_dynamic_removal);
+  o.enable_distant_filter =
+      ReadYamlKey(node, "filter", "enable_distant_filter", o.enable_distant_filter);
+  o.enhancement_keep_ratio =
+      ReadYamlKey(node, "filter", "enhancement_keep_ratio", o.enhancement_keep_ratio);
+  o.enhancement_levels = ReadYamlKey(node, "filter", "enhancement_levels", o.enhancement_levels);
+  o.enhancement_p_percent =
+      ReadYamlKey(node, "filter", "enhancement_p_percent", o.enhancement_p_percent);
+  o.enhancement_q_percent =
+      ReadYamlKey(node, "filter", "enhancement_q_percent", o.enhancement_q_percent);
+  o.box_growth = ReadYamlKey(node, "filter", "box_growth", o.box_growth);
+  o.small_box_area_ratio =
+      ReadYamlKey(node, "filter", "small_box_area_ratio", o.small_box_area_ratio);
+  o.background_matches_t =
+      ReadYamlKey(node, "filter", "background_matches_t", o.background_matches_t);
+  o.d_dis_px = ReadYamlKey(node, "filter", "d_dis_px", o.d_dis_px);
+  o.d_min_px = ReadYamlKey(node, "filter", "d_min_px", o.d_min_px);
+  o.box_vote_ratio = ReadYamlKey(node, "filter", "box_vote_ratio", o.box_vote_ratio);
+  o.box_vote_min_matches =
+      ReadYamlKey(node, "filter", "box_vote_min_matches", o.box_vote_min_matches);
+  o.dynamic_class_ids = ReadYamlKey(node, "filter", "dynamic_class_ids", o.dynamic_class_ids);
+  o.z_th_m = ReadYamlKey(node, "filter", "z_th_m", o.z_th_m);
+  o.drop_probability = ReadYamlKey(node, "filter", "drop_probability", o.drop_probability);
+  o.seed = ReadYamlKey(node, "filter", "seed", o.seed);
   o.Check();
   return o;
 }
