@@ -4,7 +4,9 @@
 #   office: 300 frames, 3 walking persons + the static mannequin, xyz motion, simulated depth,
 #           ground-truth boxes; all five ablation variants.
 #   street: 150 frames x 5 seeds, simulated depth on the float depth maps, ground-truth boxes,
-#           configs/street.yaml; full vs no_distant (median ATE over the seeds, realised drop rate).
+#           configs/street.yaml; the distant filter on/off with dynamic removal on (full vs
+#           no_distant) and off (no_dynamic vs no_dynamic_no_distant): median ATE over the seeds,
+#           realised drop rate.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${1:-$here/build/release/bin/ademono}"
@@ -14,9 +16,11 @@ mkdir -p "$work"
 office="$work/office_s7"
 [ -d "$office/rgb" ] || "$bin" synth --scene office --motion xyz --persons 3 --frames 300 --seed 7 \
   --out "$office" >/dev/null
+if [ "${SKIP_OFFICE:-0}" != 1 ]; then
 rm -rf "$work/office_ablate"
 "$bin" ablate --dataset "tum:$office" --depth simulated \
   --detector "cache:$office/detections.jsonl" --out "$work/office_ablate"
+fi
 
 for seed in 1 2 3 4 5; do
   street="$work/street_s$seed"
@@ -25,20 +29,25 @@ for seed in 1 2 3 4 5; do
   rm -rf "$work/street_ablate_s$seed"
   "$bin" ablate --dataset "tum:$street" --config "$here/configs/street.yaml" \
     --depth "simulated:gt=$street/depth_full" --detector "cache:$street/detections.jsonl" \
-    --variants full,no_distant --out "$work/street_ablate_s$seed"
+    --variants full,no_distant,no_dynamic,no_dynamic_no_distant --out "$work/street_ablate_s$seed"
 done
 python3 - "$work" <<'PY'
 import json, statistics, sys
 work = sys.argv[1]
-full, nodist, dropped, cand = [], [], 0, 0
+pairs = [("full", "no_distant"), ("no_dynamic", "no_dynamic_no_distant")]
+ate = {v: [] for p in pairs for v in p}
+dropped = cand = 0
 for seed in range(1, 6):
     v = {x["variant"]: x for x in json.load(open(f"{work}/street_ablate_s{seed}/ablation.json"))["variants"]}
-    f, n = v["full"], v["no_distant"]
-    full.append(f["ate_se3_rmse_m"]); nodist.append(n["ate_se3_rmse_m"])
-    dropped += f["filter_counts"]["removed_distant"]; cand += f["filter_counts"]["distant_candidates"]
-    print(f"street seed {seed}: ATE se3 full {f['ate_se3_rmse_m']:.4f} m, no_distant "
-          f"{n['ate_se3_rmse_m']:.4f} m; tracked {f['tracked']}/{f['frames']} and "
-          f"{n['tracked']}/{n['frames']}; distant drop {f['filter_counts']['distant_drop_rate']:.3f}")
-print(f"street median ATE se3: full {statistics.median(full):.4f} m, no_distant "
-      f"{statistics.median(nodist):.4f} m; distant drop rate {dropped}/{cand} = {dropped / cand:.3f}")
+    for name in ate:
+        ate[name].append(v[name]["ate_se3_rmse_m"])
+    for name in ("full", "no_dynamic"):
+        dropped += v[name]["filter_counts"]["removed_distant"]
+        cand += v[name]["filter_counts"]["distant_candidates"]
+    print(f"street seed {seed}: " + ", ".join(
+        f"{n} {v[n]['ate_se3_rmse_m']:.4f} m ({v[n]['tracked']}/{v[n]['frames']})" for n in ate))
+for on, off in pairs:
+    print(f"street median ATE se3: {on} {statistics.median(ate[on]):.4f} m vs {off} "
+          f"{statistics.median(ate[off]):.4f} m")
+print(f"street distant drop rate: {dropped}/{cand} = {dropped / cand:.3f}")
 PY
