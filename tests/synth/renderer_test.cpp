@@ -1,5 +1,7 @@
 #include "ademono/synth/renderer.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -236,6 +238,20 @@ TEST(CameraMotion, MotionsAreSmoothAndStaticStaysPut) {
     }
   }
   EXPECT_THROW(ParseMotionKind("spin"), std::invalid_argument);
+}
+
+// Regression: seed 11 of the 3-person office hit a footprint of exactly sqrt(2) texels, which
+// passed the level test but gave ilogb(0.99999...) = -1 and indexed before the pyramid.
+TEST(Texture, DegenerateFootprintsSampleTheCoarsestOrFinestLevel) {
+  const Texture texture = OneTexture().front();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (double footprint : {0.02 * std::sqrt(2.0), inf, nan, 1e300, 0.0, -1.0}) {
+    const cv::Vec3f colour = texture.Sample(1.0, 1.0, footprint);
+    for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isfinite(colour[c])) << footprint;
+  }
+  const cv::Mat& coarsest = texture.level(texture.num_levels() - 1);
+  EXPECT_FALSE(coarsest.empty());
 }
 
 }  // namespace

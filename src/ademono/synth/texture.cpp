@@ -229,7 +229,9 @@ cv::Vec3f Texture::Sample(double u_m, double v_m, double footprint_m) const {
   // Level whose texel is about the pixel footprint (rounded so texels are at most ~1.4 px).
   int level = 0;
   const double ratio = footprint_m / texel_m_;
-  if (ratio > 1.41421356) level = std::min(std::ilogb(ratio * 0.70710678), num_levels() - 1);
+  // Just above sqrt(2) texels ilogb(ratio / sqrt(2)) can round to -1: clamp both ends.
+  if (ratio > 1.41421356)
+    level = std::clamp(std::ilogb(ratio * 0.70710678), 0, num_levels() - 1);
   const cv::Mat& image = levels_[level];
   const double scale = 1.0 / std::ldexp(texel_m_, level);
   // Texel centres at (i + 0.5) texels; pyrDown halves sizes rounding up, so this stays aligned.
