@@ -4,13 +4,11 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <opencv2/imgproc.hpp>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -22,6 +20,7 @@
 #include "ademono/io/sequence.h"
 #include "ademono/slam/ablation.h"
 #include "command.h"
+#include "run_options.h"
 
 namespace fs = std::filesystem;
 
@@ -41,44 +40,6 @@ struct AblateArgs {
   std::string camera;
   std::string out;
 };
-
-// Same lookup as `ademono run`: $ADEMONO_CONFIG_DIR, ./configs, or the source tree of the binary.
-fs::path FindConfigDir() {
-  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0')
-    return env;
-  if (fs::is_directory("configs")) return "configs";
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
-         dir = dir.parent_path()) {
-      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt"))
-        return dir / "configs";
-    }
-  }
-  return {};
-}
-
-std::string DefaultConfigName(const std::string& kind, const std::string& path) {
-  if (kind == "tum") {
-    std::smatch m;
-    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])")))
-      return "tum_fr" + m[2].str() + ".yaml";
-    return "tum_fr1.yaml";
-  }
-  if (kind == "kitti") {
-    std::smatch m;
-    int sequence = 0;
-    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)")))
-      sequence = std::stoi(m[1].str());
-    if (sequence <= 2) return "kitti_00-02.yaml";
-    if (sequence == 3) return "kitti_03.yaml";
-    return "kitti_04-12.yaml";
-  }
-  if (kind == "7scenes") return "7scenes.yaml";
-  if (kind == "euroc") return "euroc.yaml";
-  return kind + ".yaml";
-}
 
 std::vector<AblationVariant> SelectVariants(const std::string& list) {
   const auto& all = DefaultAblationVariants();
@@ -106,62 +67,15 @@ int Ablate(const AblateArgs& args) {
   if (!args.camera.empty()) camera_yaml = args.camera;
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
 
-  fs::path config_path = args.config;
-  if (config_path.empty()) {
-    const fs::path dir = FindConfigDir();
-    const fs::path candidate = dir / DefaultConfigName(sequence->Kind(), sequence->Path().string());
-    if (!dir.empty() && fs::exists(candidate)) {
-      config_path = candidate;
-    } else {
-      spdlog::warn("no config for '{}' found ({}); using built-in defaults", sequence->Kind(),
-                   candidate.string());
-    }
-  }
-  YAML::Node config;
-  if (!config_path.empty()) {
-    RequireFile(config_path);
-    try {
-      config = YAML::LoadFile(config_path.string());
-    } catch (const YAML::Exception& e) {
-      ThrowInputError(config_path, std::string("invalid YAML: ") + e.msg);
-    }
-  }
+  const fs::path config_path = ResolveConfigPath(args.config, *sequence);
+  const YAML::Node config = LoadConfig(config_path);
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
   options.variants = variants;
-  DetectorOptions detector_options;
-  try {
-    if (const YAML::Node d = config["detector"]) {
-      if (d["score_threshold"]) detector_options.score_threshold = d["score_threshold"].as<float>();
-      if (d["nms_iou"]) detector_options.nms_iou = d["nms_iou"].as<float>();
-    }
-    detector_options.Check();
-  } catch (const std::exception& e) {
-    ThrowInputError(config_path, std::string("detector: ") + e.what());
-  }
-  if (!args.seed.empty()) {
-    try {
-      size_t used = 0;
-      options.system.filter.seed = std::stoull(args.seed, &used);
-      if (used != args.seed.size()) throw std::invalid_argument("trailing characters");
-    } catch (const std::exception&) {
-      throw InputError("--seed '" + args.seed + "': expected a non-negative integer");
-    }
-  }
-  if (!args.frames.empty()) {
-    static const std::regex pattern("^(\\d*):(\\d*)$");
-    std::smatch m;
-    if (!std::regex_match(args.frames, m, pattern))
-      throw InputError("--frames '" + args.frames + "': expected START:END (either may be empty)");
-    if (!m[1].str().empty()) options.pipeline.start = std::stoull(m[1].str());
-    if (!m[2].str().empty()) options.pipeline.end = std::stoull(m[2].str());
-    if (options.pipeline.end <= options.pipeline.start)
-      throw InputError("--frames '" + args.frames + "': END must be greater than START");
-  }
-  if (options.pipeline.start >= sequence->Size()) {
-    throw InputError("--frames '" + args.frames + "': sequence has only " +
-                     std::to_string(sequence->Size()) + " frames");
-  }
+  const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
+  if (!args.seed.empty()) options.system.filter.seed = ParseSeed(args.seed);
+  if (!args.frames.empty())
+    ParseFrames(args.frames, sequence->Size(), &options.pipeline.start, &options.pipeline.end);
   options.pipeline.overlap = !args.no_overlap;
 
   DepthFactoryContext context;
@@ -211,8 +125,9 @@ const bool kRegistered = RegisterCommand(
       app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
           ->capture_default_str();
       app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
-      app.add_option("--seed", args->seed,
-                     "random seed of the distant filter (default: the config's filter.seed)");
+      app.add_option(
+          "--seed", args->seed,
+          "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
       app.add_option("--variants", args->variants,
                      "comma-separated subset of full,no_dynamic,no_distant,"
                      "no_dynamic_no_distant,no_enhancement (default: all)");

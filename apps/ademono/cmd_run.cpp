@@ -13,7 +13,6 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -29,6 +28,7 @@
 #include "ademono/slam/pipeline.h"
 #include "ademono/slam/system.h"
 #include "command.h"
+#include "run_options.h"
 
 namespace fs = std::filesystem;
 
@@ -51,80 +51,6 @@ struct RunArgs {
   std::string camera;
   std::string out;
 };
-
-// Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
-// binary was built from (bin/ is build/<name>/bin).
-fs::path FindConfigDir() {
-  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0')
-    return env;
-  if (fs::is_directory("configs")) return "configs";
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
-         dir = dir.parent_path()) {
-      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt"))
-        return dir / "configs";
-    }
-  }
-  return {};
-}
-
-// The family config for a dataset: tum_fr1/2/3 by the "freiburgN" / "frN" in the path, kitti by
-// sequence number (00-02, 03, 04-12), else <kind>.yaml.
-std::string DefaultConfigName(const std::string& kind, const std::string& path) {
-  if (kind == "tum") {
-    std::smatch m;
-    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])")))
-      return "tum_fr" + m[2].str() + ".yaml";
-    return "tum_fr1.yaml";
-  }
-  if (kind == "kitti") {
-    std::smatch m;
-    int sequence = 0;
-    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)")))
-      sequence = std::stoi(m[1].str());
-    if (sequence <= 2) return "kitti_00-02.yaml";
-    if (sequence == 3) return "kitti_03.yaml";
-    return "kitti_04-12.yaml";
-  }
-  if (kind == "7scenes") return "7scenes.yaml";
-  if (kind == "euroc") return "euroc.yaml";
-  return kind + ".yaml";
-}
-
-YAML::Node LoadConfig(const fs::path& path) {
-  RequireFile(path);
-  try {
-    return YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(path, std::string("invalid YAML: ") + e.msg);
-  }
-}
-
-void ParseFrames(const std::string& text, size_t* start, size_t* end) {
-  static const std::regex pattern("^(\\d*):(\\d*)$");
-  std::smatch m;
-  if (!std::regex_match(text, m, pattern)) {
-    throw InputError("--frames '" + text + "': expected START:END (either may be empty)");
-  }
-  if (!m[1].str().empty()) *start = std::stoull(m[1].str());
-  if (!m[2].str().empty()) *end = std::stoull(m[2].str());
-  if (*end <= *start) throw InputError("--frames '" + text + "': END must be greater than START");
-}
-
-uint64_t ParseSeed(const std::string& text) {
-  if (text == "time") {
-    return static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
-  }
-  try {
-    size_t used = 0;
-    const uint64_t seed = std::stoull(text, &used);
-    if (used == text.size()) return seed;
-  } catch (const std::exception&) {
-  }
-  throw InputError("--seed '" + text + "': expected a non-negative integer or 'time'");
-}
 
 void WritePly(const fs::path& path, const std::vector<System::ColoredPoint>& cloud) {
   WriteFileAtomic(path, [&](std::ostream& os) {
@@ -191,29 +117,10 @@ int Run(const RunArgs& args) {
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
 
   // Config: --config or the dataset family's default.
-  fs::path config_path = args.config;
-  if (config_path.empty()) {
-    const fs::path dir = FindConfigDir();
-    const fs::path candidate = dir / DefaultConfigName(sequence->Kind(), sequence->Path().string());
-    if (!dir.empty() && fs::exists(candidate)) {
-      config_path = candidate;
-    } else {
-      spdlog::warn("no config for '{}' found ({}); using built-in defaults", sequence->Kind(),
-                   candidate.string());
-    }
-  }
-  YAML::Node config = config_path.empty() ? YAML::Node() : LoadConfig(config_path);
+  const fs::path config_path = ResolveConfigPath(args.config, *sequence);
+  const YAML::Node config = LoadConfig(config_path);
   SystemOptions options = SystemOptions::FromYaml(config, config_path);
-  DetectorOptions detector_options;
-  try {
-    if (const YAML::Node d = config["detector"]) {
-      if (d["score_threshold"]) detector_options.score_threshold = d["score_threshold"].as<float>();
-      if (d["nms_iou"]) detector_options.nms_iou = d["nms_iou"].as<float>();
-    }
-    detector_options.Check();
-  } catch (const std::exception& e) {
-    ThrowInputError(config_path, std::string("detector: ") + e.what());
-  }
+  const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.filter.seed = ParseSeed(args.seed);
   if (args.no_enhancement) options.filter.enable_enhancement = false;
   if (args.no_dynamic_removal) options.filter.enable_dynamic_removal = false;
@@ -221,11 +128,8 @@ int Run(const RunArgs& args) {
   if (args.threaded) options.mapping.deterministic = false;
 
   PipelineOptions pipeline;
-  if (!args.frames.empty()) ParseFrames(args.frames, &pipeline.start, &pipeline.end);
-  if (pipeline.start >= sequence->Size()) {
-    throw InputError("--frames '" + args.frames + "': sequence has only " +
-                     std::to_string(sequence->Size()) + " frames");
-  }
+  if (!args.frames.empty())
+    ParseFrames(args.frames, sequence->Size(), &pipeline.start, &pipeline.end);
   pipeline.overlap = !args.no_overlap;
 
   DepthFactoryContext context;

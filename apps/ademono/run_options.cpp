@@ -1,0 +1,114 @@
+#include "run_options.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <regex>
+
+#include "ademono/core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace ademono::cli {
+
+fs::path FindConfigDir() {
+  if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0')
+    return env;
+  if (fs::is_directory("configs")) return "configs";
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path();
+         dir = dir.parent_path()) {
+      if (fs::is_directory(dir / "configs") && fs::exists(dir / "CMakeLists.txt"))
+        return dir / "configs";
+    }
+  }
+  return {};
+}
+
+std::string DefaultConfigName(const std::string& kind, const std::string& path) {
+  if (kind == "tum") {
+    std::smatch m;
+    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])")))
+      return "tum_fr" + m[2].str() + ".yaml";
+    return "tum_fr1.yaml";
+  }
+  if (kind == "kitti") {
+    std::smatch m;
+    int sequence = 0;
+    if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)")))
+      sequence = std::stoi(m[1].str());
+    if (sequence <= 2) return "kitti_00-02.yaml";
+    if (sequence == 3) return "kitti_03.yaml";
+    return "kitti_04-12.yaml";
+  }
+  if (kind == "7scenes") return "7scenes.yaml";
+  if (kind == "euroc") return "euroc.yaml";
+  return kind + ".yaml";
+}
+
+fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence) {
+  if (!config_arg.empty()) return config_arg;
+  const fs::path dir = FindConfigDir();
+  const fs::path candidate = dir / DefaultConfigName(sequence.Kind(), sequence.Path().string());
+  if (!dir.empty() && fs::exists(candidate)) return candidate;
+  spdlog::warn("no config for '{}' found ({}); using built-in defaults", sequence.Kind(),
+               candidate.string());
+  return {};
+}
+
+YAML::Node LoadConfig(const fs::path& path) {
+  if (path.empty()) return YAML::Node();
+  RequireFile(path);
+  try {
+    return YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(path, std::string("invalid YAML: ") + e.msg);
+  }
+}
+
+DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config, const fs::path& config_path) {
+  DetectorOptions options;
+  try {
+    if (const YAML::Node d = config["detector"]) {
+      if (d["score_threshold"]) options.score_threshold = d["score_threshold"].as<float>();
+      if (d["nms_iou"]) options.nms_iou = d["nms_iou"].as<float>();
+    }
+    options.Check();
+  } catch (const std::exception& e) {
+    ThrowInputError(config_path, std::string("detector: ") + e.what());
+  }
+  return options;
+}
+
+void ParseFrames(const std::string& text, size_t size, size_t* start, size_t* end) {
+  static const std::regex pattern("^(\\d*):(\\d*)$");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern)) {
+    throw InputError("--frames '" + text + "': expected START:END (either may be empty)");
+  }
+  if (!m[1].str().empty()) *start = std::stoull(m[1].str());
+  if (!m[2].str().empty()) *end = std::stoull(m[2].str());
+  if (*end <= *start) throw InputError("--frames '" + text + "': END must be greater than START");
+  if (*start >= size) {
+    throw InputError("--frames '" + text + "': sequence has only " + std::to_string(size) +
+                     " frames");
+  }
+}
+
+uint64_t ParseSeed(const std::string& text) {
+  if (text == "time") {
+    return static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+  }
+  try {
+    size_t used = 0;
+    const uint64_t seed = std::stoull(text, &used);
+    if (used == text.size() && text.find('-') == std::string::npos) return seed;
+  } catch (const std::exception&) {
+  }
+  throw InputError("--seed '" + text + "': expected a non-negative integer or 'time'");
+}
+
+}  // namespace ademono::cli

@@ -1,0 +1,34 @@
+#pragma once
+// Options shared by `ademono run` and `ademono ablate`: the dataset family's config file, the
+// detector options in it, and the --frames / --seed arguments.
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "ademono/detect/detector_factory.h"
+#include "ademono/io/sequence.h"
+
+namespace ademono::cli {
+
+// Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
+// binary was built from (bin/ is build/<name>/bin). Empty when none is found.
+std::filesystem::path FindConfigDir();
+// The family config for a dataset: tum_fr1/2/3 by the "freiburgN" / "frN" in the path, kitti by
+// sequence number (00-02, 03, 04-12), else <kind>.yaml.
+std::string DefaultConfigName(const std::string& kind, const std::string& path);
+// `config_arg` if given, else the family's file; empty (with a warning) when there is none.
+std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence);
+// The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
+YAML::Node LoadConfig(const std::filesystem::path& path);
+// The `detector:` node's score_threshold and nms_iou, checked.
+DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config,
+                                          const std::filesystem::path& config_path);
+// "START:END" (either may be empty; END exclusive) within a sequence of `size` frames.
+void ParseFrames(const std::string& text, size_t size, size_t* start, size_t* end);
+// A non-negative integer, or "time" for a time-based seed (the paper's choice).
+uint64_t ParseSeed(const std::string& text);
+
+}  // namespace ademono::cli
