@@ -27,18 +27,8 @@ namespace fs = std::filesystem;
 namespace ademono::cli {
 namespace {
 
-struct AblateArgs {
-  std::string dataset;
-  std::string config;
-  std::string depth = "sensor";
-  std::string detector = "none";
-  std::string frames;
-  std::string seed;
+struct AblateArgs : SequenceRunArgs {
   std::string variants;  // comma-separated subset, empty: all five
-  bool no_overlap = false;
-  std::string viz;
-  std::string camera;
-  std::string out;
 };
 
 std::vector<AblationVariant> SelectVariants(const std::string& list) {
@@ -115,28 +105,10 @@ const bool kRegistered = RegisterCommand(
     "Run the filter ablation (5 variants) over a sequence: ATE, tracking, filter counts table",
     [](CLI::App& app) -> Runner {
       auto args = std::make_shared<AblateArgs>();
-      app.add_option("--dataset", args->dataset,
-                     "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")
-          ->required();
-      app.add_option("--config", args->config, "config YAML (default: configs/<family>.yaml)");
-      app.add_option("--depth", args->depth,
-                     "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
-          ->capture_default_str();
-      app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
-          ->capture_default_str();
-      app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
-      app.add_option(
-          "--seed", args->seed,
-          "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
+      AddSequenceRunOptions(app, *args);
       app.add_option("--variants", args->variants,
                      "comma-separated subset of full,no_dynamic,no_distant,"
                      "no_dynamic_no_distant,no_enhancement (default: all)");
-      app.add_flag("--no-overlap", args->no_overlap,
-                   "compute depth/detections sequentially (no prefetch)");
-      app.add_option("--viz", args->viz,
-                     "write per-frame images with filter labels into DIR/<variant>/");
-      app.add_option("--camera", args->camera, "camera YAML (overrides the dataset's)");
-      app.add_option("--out", args->out, "output directory")->required();
       return [args] { return Ablate(*args); };
     });
 

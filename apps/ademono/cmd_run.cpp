@@ -35,21 +35,11 @@ namespace fs = std::filesystem;
 namespace ademono::cli {
 namespace {
 
-struct RunArgs {
-  std::string dataset;
-  std::string config;
-  std::string depth = "sensor";
-  std::string detector = "none";
-  std::string frames;
-  std::string seed;  // empty: the config's filter.seed
+struct RunArgs : SequenceRunArgs {
   bool no_enhancement = false;
   bool no_dynamic_removal = false;
   bool no_distant_filter = false;
   bool threaded = false;
-  bool no_overlap = false;
-  std::string viz;
-  std::string camera;
-  std::string out;
 };
 
 void WritePly(const fs::path& path, const std::vector<System::ColoredPoint>& cloud) {
@@ -249,19 +239,7 @@ const bool kRegistered = RegisterCommand(
     "run", "Run SLAM over a dataset sequence and write trajectory, keyframes, map and summary",
     [](CLI::App& app) -> Runner {
       auto args = std::make_shared<RunArgs>();
-      app.add_option("--dataset", args->dataset,
-                     "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")
-          ->required();
-      app.add_option("--config", args->config, "config YAML (default: configs/<family>.yaml)");
-      app.add_option("--depth", args->depth,
-                     "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
-          ->capture_default_str();
-      app.add_option("--detector", args->detector, "none | cache:FILE.jsonl | model:FILE.onnx")
-          ->capture_default_str();
-      app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
-      app.add_option(
-          "--seed", args->seed,
-          "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
+      AddSequenceRunOptions(app, *args);
       app.add_flag("--no-enhancement", args->no_enhancement,
                    "disable depth-weighted feature enhancement");
       app.add_flag("--no-dynamic-removal", args->no_dynamic_removal,
@@ -271,11 +249,6 @@ const bool kRegistered = RegisterCommand(
       app.add_flag(
           "--threaded", args->threaded,
           "local mapping in its own thread (faster wall time, not reproducible run to run)");
-      app.add_flag("--no-overlap", args->no_overlap,
-                   "compute depth/detections sequentially (no prefetch)");
-      app.add_option("--viz", args->viz, "write per-frame images with filter labels into DIR");
-      app.add_option("--camera", args->camera, "camera YAML (overrides the dataset's)");
-      app.add_option("--out", args->out, "output directory")->required();
       return [args] { return Run(*args); };
     });
 

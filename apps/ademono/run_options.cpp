@@ -12,6 +12,26 @@ namespace fs = std::filesystem;
 
 namespace ademono::cli {
 
+void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
+  app.add_option("--dataset", args.dataset, "KIND:PATH (tum, kitti, euroc, 7scenes, folder, video)")
+      ->required();
+  app.add_option("--config", args.config, "config YAML (default: configs/<family>.yaml)");
+  app.add_option("--depth", args.depth,
+                 "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
+      ->capture_default_str();
+  app.add_option("--detector", args.detector, "none | cache:FILE.jsonl | model:FILE.onnx")
+      ->capture_default_str();
+  app.add_option("--frames", args.frames, "START:END frame range (END exclusive)");
+  app.add_option(
+      "--seed", args.seed,
+      "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
+  app.add_flag("--no-overlap", args.no_overlap,
+               "compute depth/detections sequentially (no prefetch)");
+  app.add_option("--viz", args.viz, "write per-frame images with filter labels into DIR");
+  app.add_option("--camera", args.camera, "camera YAML (overrides the dataset's)");
+  app.add_option("--out", args.out, "output directory")->required();
+}
+
 fs::path FindConfigDir() {
   if (const char* env = std::getenv("ADEMONO_CONFIG_DIR"); env != nullptr && *env != '\0')
     return env;

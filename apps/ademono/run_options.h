@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -12,6 +13,23 @@
 #include "ademono/io/sequence.h"
 
 namespace ademono::cli {
+
+// Arguments `run` and `ablate` share: what to run on, with which depth and detections, and where
+// to write.
+struct SequenceRunArgs {
+  std::string dataset;
+  std::string config;
+  std::string depth = "sensor";
+  std::string detector = "none";
+  std::string frames;
+  std::string seed;  // empty: the config's filter.seed
+  bool no_overlap = false;
+  std::string viz;
+  std::string camera;
+  std::string out;
+};
+// --dataset --config --depth --detector --frames --seed --no-overlap --viz --camera --out.
+void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args);
 
 // Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
 // binary was built from (bin/ is build/<name>/bin). Empty when none is found.
