@@ -12,23 +12,17 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli_test_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
 using ::testing::HasSubstr;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
+using RunResult = ademono::cli_test::CliRun;
+using ademono::cli_test::ReadFile;
 
-std::string Read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 class AblateCliTest : public ::testing::Test {
  protected:
@@ -47,17 +41,7 @@ class AblateCliTest : public ::testing::Test {
     fs::remove_all(dir_, ec);
   }
   static RunResult Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(ADEMONO_CLI) + " --log-level warn " + args + " >" +
-                            out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Read(out);
-    r.err = Read(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    return ademono::cli_test::RunAdemono("--log-level warn " + args, dir_);
   }
   static std::string Sequence() { return (dir_ / "office").string(); }
 
@@ -77,7 +61,7 @@ TEST_F(AblateCliTest, FiveVariantsAndTable) {
     for (const char* f : {"trajectory.tum", "keyframes.tum", "summary.json"})
       EXPECT_TRUE(fs::exists(out / v / f)) << v << "/" << f;
   }
-  const std::string md = Read(out / "ablation.md");
+  const std::string md = ReadFile(out / "ablation.md");
   EXPECT_EQ(md, r.out);
   for (const char* column :
        {"ATE se3 (m)", "ATE sim3 (m)", "tracked", "keyframes", "removed enh", "removed dyn",

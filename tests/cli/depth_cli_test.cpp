@@ -6,11 +6,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "ademono/core/camera.h"
-#include "onnx_cli_util.h"
+#include "cli_test_util.h"
 
 namespace {
 
-using namespace ademono::onnx_cli_test;
+using namespace ademono::cli_test;
 namespace fs = std::filesystem;
 const fs::path kModels = fs::path(ADEMONO_SOURCE_DIR) / "tests/data/models";
 

@@ -7,11 +7,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "onnx_cli_util.h"
+#include "cli_test_util.h"
 
 namespace {
 
-using namespace ademono::onnx_cli_test;
+using namespace ademono::cli_test;
 namespace fs = std::filesystem;
 const fs::path kShared = ADEMONO_SHARED_DIR;
 const fs::path kModels = fs::path(ADEMONO_SOURCE_DIR) / "tests/data/models";

@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli_test_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -19,10 +21,8 @@ using ::testing::HasSubstr;
 
 const fs::path kTraj = fs::path(ADEMONO_SHARED_DIR) / "data" / "trajectories";
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
+using RunResult = ademono::cli_test::CliRun;
+using ademono::cli_test::ReadFile;
 
 class EvalCliTest : public ::testing::Test {
  protected:
@@ -41,21 +41,7 @@ class EvalCliTest : public ::testing::Test {
   }
 
   RunResult Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd =
-        std::string(ADEMONO_CLI) + " eval " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Read(out);
-    r.err = Read(err);
-    return r;
-  }
-  static std::string Read(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    return ademono::cli_test::RunAdemono("eval " + args, dir_);
   }
   static size_t Lines(const std::string& text) {
     return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
@@ -76,7 +62,7 @@ TEST_F(EvalCliTest, TumSe3WritesJsonAndPlot) {
           " --format tum --align se3 --json " + json.string() + " --plot " + svg.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("APE translation"));
-  const nlohmann::json j = nlohmann::json::parse(Read(json));
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(json));
   const nlohmann::json e = Expected()["evo"]["fr1_xyz_rgbdslam"];
   EXPECT_EQ(j["alignment"], "se3");
   EXPECT_NEAR(j["ape"]["rmse"].get<double>(), e["ape_se3"]["rmse"].get<double>(), 1e-8);
@@ -90,7 +76,7 @@ TEST_F(EvalCliTest, TumSe3WritesJsonAndPlot) {
   EXPECT_FALSE(j.contains("kitti"));
   EXPECT_FALSE(j.contains("scale"));
   EXPECT_GT(j["matched_poses"].get<int>(), 700);
-  const std::string plot = Read(svg);
+  const std::string plot = ReadFile(svg);
   EXPECT_EQ(plot.rfind("<?xml", 0), 0u);
   EXPECT_THAT(plot, HasSubstr("</svg>"));
   EXPECT_THAT(plot, HasSubstr("<polyline"));
@@ -107,7 +93,7 @@ TEST_F(EvalCliTest, KittiMetricsAndSim3Scale) {
                           (kTraj / "kitti-odom-eval/example_1/10.txt").string() +
                           " --format kitti --align sim3 --kitti-metrics --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const nlohmann::json j = nlohmann::json::parse(Read(json));
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(json));
   const nlohmann::json e = Expected()["kitti_odom_eval"]["example_1"]["7dof"]["10"];
   EXPECT_NEAR(j["kitti"]["t_rel_percent"].get<double>(), e["t_rel_percent"].get<double>(), 5e-4);
   EXPECT_NEAR(j["kitti"]["r_rel_deg_per_100m"].get<double>(), e["r_rel_deg_per_100m"].get<double>(),
@@ -139,7 +125,7 @@ TEST_F(EvalCliTest, MixedFormatsEurocGroundTruthAgainstTumEstimate) {
       Run("--gt " + (dir_ / "gt.csv").string() + " --gt-format euroc --est " +
           (dir_ / "est.txt").string() + " --est-format tum --align none --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  nlohmann::json j = nlohmann::json::parse(Read(json));
+  nlohmann::json j = nlohmann::json::parse(ReadFile(json));
   EXPECT_EQ(j["matched_poses"], 5);
   EXPECT_LT(j["ape"]["max"].get<double>(), 1e-6);
   // A KITTI estimate has no timestamps: matched by index.
@@ -147,7 +133,7 @@ TEST_F(EvalCliTest, MixedFormatsEurocGroundTruthAgainstTumEstimate) {
           (dir_ / "est.kitti").string() + " --est-format kitti --align none --json " +
           json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  j = nlohmann::json::parse(Read(json));
+  j = nlohmann::json::parse(ReadFile(json));
   EXPECT_EQ(j["matched_poses"], 5);
   EXPECT_LT(j["ape"]["max"].get<double>(), 1e-9);
   // RPE 10 frames on 5 poses: no pairs, said plainly.

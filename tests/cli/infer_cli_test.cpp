@@ -9,11 +9,11 @@
 #include "ademono/depth/onnx_depth.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
-#include "onnx_cli_util.h"
+#include "cli_test_util.h"
 
 namespace {
 
-using namespace ademono::onnx_cli_test;
+using namespace ademono::cli_test;
 namespace fs = std::filesystem;
 const fs::path kModels = fs::path(ADEMONO_SOURCE_DIR) / "tests/data/models";
 const fs::path kSevenScenes = fs::path(ADEMONO_SHARED_DIR) / "data/7scenes-seq-a";

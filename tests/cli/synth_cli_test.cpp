@@ -13,16 +13,16 @@
 #include "ademono/detect/detection_io.h"
 #include "ademono/io/sequence.h"
 
+#include "cli_test_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
 using ::testing::HasSubstr;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
+using RunResult = ademono::cli_test::CliRun;
+using ademono::cli_test::ReadFile;
 
 class SynthCliTest : public ::testing::Test {
  protected:
@@ -40,23 +40,7 @@ class SynthCliTest : public ::testing::Test {
   }
 
   RunResult Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(ADEMONO_CLI) + " --log-level warn synth " + args + " >" +
-                            out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Read(out);
-    r.err = Read(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
-  }
-  static std::string Read(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    return ademono::cli_test::RunAdemono("--log-level warn synth " + args, dir_);
   }
   // Entries of the test folder (the CLI must leave no temporary folders).
   std::vector<std::string> Entries() const {
@@ -130,7 +114,7 @@ TEST_F(SynthCliTest, RefusesNonEmptyOutputFolder) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("out: exists and is not empty"));
   EXPECT_EQ(Entries(), (std::vector<std::string>{"out"}));
-  EXPECT_EQ(Read(dir_ / "out" / "keep.txt"), "mine");
+  EXPECT_EQ(ReadFile(dir_ / "out" / "keep.txt"), "mine");
 }
 
 }  // namespace
