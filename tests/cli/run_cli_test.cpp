@@ -10,33 +10,15 @@
 #include <sstream>
 #include <string>
 
+#include "cli_test_util.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout + stderr
-};
-
-CommandResult RunCli(const std::string& args) {
-  const std::string command = std::string(ADEMONO_CLI) + " " + args + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe) != nullptr) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using ademono::cli_test::CliResult;
+using ademono::cli_test::ReadFile;
+using ademono::cli_test::RunCli;
 
 class RunCliTest : public ::testing::Test {
  protected:
@@ -55,10 +37,10 @@ class RunCliTest : public ::testing::Test {
 };
 
 TEST_F(RunCliTest, WritesAllOutputsForASlice) {
-  const CommandResult r =
+  const CliResult r =
       RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 0:30 --viz " +
              (out_ / "viz").string() + " --out " + out_.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.out;
   for (const char* name :
        {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out_ / name)) << name;
@@ -67,7 +49,7 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
   for (const auto& entry : fs::directory_iterator(out_ / "viz"))
     viz_images += entry.path().extension() == ".jpg";
   EXPECT_EQ(viz_images, 30);
-  const nlohmann::json summary = nlohmann::json::parse(ReadAll(out_ / "summary.json"));
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(out_ / "summary.json"));
   EXPECT_EQ(summary["frames"], 30);
   EXPECT_LT(summary["accuracy"]["ate_se3_rmse_m"].get<double>(), 0.03);
   EXPECT_EQ(summary["tracked"], 30);
@@ -82,14 +64,14 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
   }
   // 30 TUM lines, 30 KITTI lines, a PLY header with the vertex count.
   int tum_lines = 0, kitti_lines = 0;
-  std::istringstream tum(ReadAll(out_ / "trajectory.tum")),
-      kitti(ReadAll(out_ / "trajectory.kitti"));
+  std::istringstream tum(ReadFile(out_ / "trajectory.tum")),
+      kitti(ReadFile(out_ / "trajectory.kitti"));
   for (std::string line; std::getline(tum, line);)
     tum_lines += (!line.empty() && line[0] != '#') ? 1 : 0;
   for (std::string line; std::getline(kitti, line);) kitti_lines += line.empty() ? 0 : 1;
   EXPECT_EQ(tum_lines, 30);
   EXPECT_EQ(kitti_lines, 30);
-  const std::string ply = ReadAll(out_ / "map.ply");
+  const std::string ply = ReadFile(out_ / "map.ply");
   EXPECT_EQ(ply.rfind("ply\n", 0), 0u);
   EXPECT_NE(ply.find("element vertex " + std::to_string(summary["map_points"].get<int>())),
             std::string::npos);
@@ -99,14 +81,14 @@ TEST_F(RunCliTest, TwoRunsWriteIdenticalTrajectories) {
   const fs::path second = out_ / "second";
   ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() +
                    " --frames 200:225 --out " + (out_ / "first").string())
-                .exit_code,
+                .code,
             0);
   ASSERT_EQ(RunCli("run --dataset " + Dataset() + " --config " + Config() +
                    " --frames 200:225 --no-overlap --out " + second.string())
-                .exit_code,
+                .code,
             0);
-  EXPECT_EQ(ReadAll(out_ / "first" / "trajectory.tum"), ReadAll(second / "trajectory.tum"));
-  EXPECT_FALSE(ReadAll(second / "trajectory.tum").empty());
+  EXPECT_EQ(ReadFile(out_ / "first" / "trajectory.tum"), ReadFile(second / "trajectory.tum"));
+  EXPECT_FALSE(ReadFile(second / "trajectory.tum").empty());
 }
 
 TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
@@ -124,15 +106,15 @@ TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
       {"--frames 0:5 --seed abc", "--seed"},
   };
   for (const Case& c : cases) {
-    const CommandResult r =
+    const CliResult r =
         RunCli("run --dataset " + Dataset() + " " + c.args + " --out " + out_.string());
-    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.output;
-    EXPECT_NE(r.output.find("ademono run: error:"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find(c.needle), std::string::npos) << r.output;
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find("ademono run: error:"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(c.needle), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(out_ / "trajectory.tum")) << c.args;
   }
-  const CommandResult r = RunCli("run --dataset 7scenes:/nonexistent/scene --out " + out_.string());
-  EXPECT_EQ(r.exit_code, 2) << r.output;
+  const CliResult r = RunCli("run --dataset 7scenes:/nonexistent/scene --out " + out_.string());
+  EXPECT_EQ(r.code, 2) << r.out;
   fs::remove(bad_config);
 }
 
