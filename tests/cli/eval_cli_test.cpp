@@ -28,12 +28,8 @@ class EvalCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(kTraj / "expected.json")) GTEST_SKIP() << "no shared data";
-    dir_ = fs::temp_directory_path() /
-           ("ademono_eval_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = ademono::cli_test::FreshTempDir(
+        std::string("eval_cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override {
     std::error_code ec;

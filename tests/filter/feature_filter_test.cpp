@@ -6,18 +6,12 @@
 #include <limits>
 #include <random>
 
+#include "filter_test_util.h"
+
 namespace ademono {
 namespace {
 
-Camera TestCamera() {
-  Camera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = c.fy = 500;
-  c.cx = 320;
-  c.cy = 240;
-  return c;
-}
+using filter_test::TestCamera;
 
 TEST(PointLabelNameTest, Names) {
   EXPECT_STREQ(PointLabelName(PointLabel::kKept), "kept");
