@@ -225,6 +225,155 @@ TEST(RemoveDynamicPointsTest, InactivePointsAreLeftAlone) {
   EXPECT_EQ(r.labels[Scene::kLargeStage2], PointLabel::kDynamicStage2);
 }
 
+// Forward motion (the street case): the camera moves 0.5 m ahead between frames. Static points
+// then flow outwards by an amount that grows with image position and inverse depth, so a parked
+// car's near points differ from the background's mean displacement by far more than D_dis.
+struct ForwardScene {
+  Camera camera = TestCamera();
+  // One large box (car class) on the right half of the image.
+  std::vector<Detection> detections{Det(2, 400, 150, 220, 300)};
+  std::vector<cv::KeyPoint> cur, prev;
+  cv::Mat cur_desc, prev_desc;
+  std::vector<float> cur_depths;
+  PreviousFrameFeatures previous;
+  Rigid3d cur_from_prev = Rigid3d::Identity();
+
+  enum : int {
+    kParked1 = 0,        // static, 4 m away, in the box: prev depth known
+    kParked2,            // static, 5 m
+    kParkedNoPrevDepth,  // static, 4.5 m, depth known only in the current frame
+    kMoving,             // the 3D point moved 0.4 m sideways: prev depth known
+    kMovingNoPrevDepth,  // moved 0.4 m sideways, depth known only in the current frame
+    kNoDepth,            // static, depth unknown in both frames: no verdict
+    kBoxCount
+  };
+
+  ForwardScene() {
+    cur_from_prev.translation() = Eigen::Vector3d(0, 0, -0.5);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Vector3d no_point(nan, nan, nan);
+    auto add = [&](const Eigen::Vector3d& prev_cam, const Eigen::Vector3d& motion, bool prev_depth,
+                   bool cur_depth) {
+      const Eigen::Vector3d cur_cam = cur_from_prev * (prev_cam + motion);
+      const Eigen::Vector2d p = camera.Project(prev_cam), c = camera.Project(cur_cam);
+      prev.push_back(Kp(static_cast<float>(p.x()), static_cast<float>(p.y())));
+      cur.push_back(Kp(static_cast<float>(c.x()), static_cast<float>(c.y())));
+      previous.points_cam.push_back(prev_depth ? prev_cam : no_point);
+      cur_depths.push_back(cur_depth ? static_cast<float>(cur_cam.z()) : -1.f);
+    };
+    const Eigen::Vector3d still = Eigen::Vector3d::Zero(), sideways(0.4, 0, 0);
+    auto at = [&](double u, double v, double z) {
+      return camera.Unproject(Eigen::Vector2d(u, v), z);
+    };
+    add(at(520, 300, 4), still, true, true);
+    add(at(580, 250, 5), still, true, true);
+    add(at(480, 380, 4.5), still, false, true);
+    add(at(470, 260, 6), sideways, true, true);
+    add(at(540, 340, 6), sideways, false, true);
+    add(at(450, 220, 7), still, false, false);
+    // Background: a grid of static points at 3-20 m on the left of the image, outside the box.
+    for (int k = 0; k < 24; ++k) {
+      const double u = 30 + 60 * (k % 6), v = 40 + 110 * (k / 6);
+      add(at(u, v, 3.0 + 17.0 * ((k * 7) % 24) / 23.0), still, true, k % 3 != 0);
+    }
+    cur_desc = RandomDescriptors(static_cast<int>(cur.size()), 11);
+    prev_desc = cur_desc.clone();
+    previous.keypoints = prev;
+    previous.descriptors = prev_desc;
+  }
+
+  DynamicInput Input() const {
+    DynamicInput in;
+    in.keypoints = &cur;
+    in.descriptors = &cur_desc;
+    in.detections = &detections;
+    in.previous = &previous;
+    in.camera = &camera;
+    in.depths = &cur_depths;
+    return in;  // no constant-velocity prediction: stage 2 does not run
+  }
+};
+
+DynamicParams ForwardParams() {
+  DynamicParams p;
+  p.box_vote_ratio = 2.0;  // judge every point on its own evidence
+  return p;
+}
+
+TEST(FitBackgroundMotionTest, RecoversTheCameraMotionFromTheBackground) {
+  const ForwardScene s;
+  std::vector<cv::DMatch> matches;
+  std::vector<char> in_box(s.cur.size(), 0);
+  for (size_t i = 0; i < s.cur.size(); ++i) {
+    matches.emplace_back(static_cast<int>(i), static_cast<int>(i), 0.f);
+    in_box[i] = i < ForwardScene::kBoxCount;  // the moving points must not take part
+  }
+  int inliers = 0;
+  const std::optional<Rigid3d> fit =
+      FitBackgroundMotion(s.cur, s.previous, matches, in_box, s.camera, ForwardParams(), &inliers);
+  ASSERT_TRUE(fit.has_value());
+  EXPECT_EQ(inliers, 24);
+  EXPECT_LT((fit->translation() - s.cur_from_prev.translation()).norm(), 1e-4);
+  EXPECT_LT((fit->linear() - Eigen::Matrix3d::Identity()).norm(), 1e-4);
+  // Too few background points with depth: no fit.
+  DynamicParams p = ForwardParams();
+  p.motion_min_inliers = 25;
+  EXPECT_FALSE(FitBackgroundMotion(s.cur, s.previous, matches, in_box, s.camera, p).has_value());
+}
+
+TEST(RemoveDynamicPointsTest, MotionCompensationKeepsStaticObjectsUnderForwardMotion) {
+  const ForwardScene s;
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), ForwardParams());
+  EXPECT_TRUE(r.motion_compensated);
+  EXPECT_EQ(r.num_motion_inliers, 24);
+  ASSERT_TRUE(r.background_motion.has_value());
+  EXPECT_LT(r.background_motion->norm(), 1e-3);  // the fit explains the background exactly
+  EXPECT_EQ(r.labels[ForwardScene::kParked1], PointLabel::kKept);
+  EXPECT_EQ(r.labels[ForwardScene::kParked2], PointLabel::kKept);
+  EXPECT_EQ(r.labels[ForwardScene::kParkedNoPrevDepth], PointLabel::kKept);  // checked backwards
+  EXPECT_EQ(r.labels[ForwardScene::kMoving], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[ForwardScene::kMovingNoPrevDepth], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[ForwardScene::kNoDepth], PointLabel::kKept);  // no evidence either way
+  for (size_t i = ForwardScene::kBoxCount; i < s.cur.size(); ++i)
+    EXPECT_EQ(r.labels[i], PointLabel::kKept);
+}
+
+TEST(RemoveDynamicPointsTest, PaperStageOneJudgesParkedCarsMovingUnderForwardMotion) {
+  // The paper's single mean displacement: the near static points flow far more than the
+  // background's mean and are removed; this is why compensation is the default.
+  const ForwardScene s;
+  DynamicParams p = ForwardParams();
+  p.stage1_motion_compensation = false;
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), p);
+  EXPECT_FALSE(r.motion_compensated);
+  EXPECT_EQ(r.labels[ForwardScene::kParked1], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[ForwardScene::kParked2], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[ForwardScene::kParkedNoPrevDepth], PointLabel::kDynamicStage1);
+}
+
+TEST(RemoveDynamicPointsTest, UnjudgedPointsFollowTheBoxVote) {
+  // With the vote on, the box's judged points: 2 of 5 moved (40 %): the point without depth in
+  // either frame (no verdict of its own) goes with its box.
+  const ForwardScene s;
+  DynamicParams p = ForwardParams();
+  p.box_vote_ratio = 0.3;
+  p.box_vote_min_matches = 5;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[ForwardScene::kNoDepth],
+            PointLabel::kDynamicBoxVote);
+  p.box_vote_ratio = 0.5;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[ForwardScene::kNoDepth], PointLabel::kKept);
+}
+
+TEST(RemoveDynamicPointsTest, WithoutBackgroundDepthStageOneFallsBackToThePaperTest) {
+  ForwardScene s;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (size_t i = ForwardScene::kBoxCount; i < s.cur.size(); ++i)
+    s.previous.points_cam[i] = Eigen::Vector3d(nan, nan, nan);
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), ForwardParams());
+  EXPECT_FALSE(r.motion_compensated);
+  EXPECT_EQ(r.labels[ForwardScene::kParked1], PointLabel::kDynamicStage1);
+}
+
 TEST(RemoveDynamicPointsTest, NoDetectionsKeepsEverythingAndBadInputThrows) {
   Scene s;
   s.detections.clear();
@@ -236,6 +385,12 @@ TEST(RemoveDynamicPointsTest, NoDetectionsKeepsEverythingAndBadInputThrows) {
   DynamicInput in = t.Input();
   in.camera = nullptr;
   EXPECT_THROW(RemoveDynamicPoints(in, Params()), std::invalid_argument);
+  Scene u;
+  u.previous.points_cam.resize(3);
+  EXPECT_THROW(RemoveDynamicPoints(u.Input(), Params()), std::invalid_argument);
+  ForwardScene f;
+  f.cur_depths.pop_back();
+  EXPECT_THROW(RemoveDynamicPoints(f.Input(), ForwardParams()), std::invalid_argument);
 }
 
 }  // namespace

@@ -25,7 +25,8 @@ TEST(PointLabelNameTest, Names) {
 TEST(FilterOptionsTest, FromYamlAndCheck) {
   const FilterOptions o = FilterOptions::FromYaml(
       YAML::Load("{enable_enhancement: false, enhancement_levels: 1, box_growth: 0.05, "
-                 "dynamic_class_ids: [0, 2], z_th_m: 20, drop_probability: 0.25, seed: 7}"));
+                 "dynamic_class_ids: [0, 2], z_th_m: 20, drop_probability: 0.25, seed: 7, "
+                 "stage1_motion_compensation: false}"));
   EXPECT_FALSE(o.enable_enhancement);
   EXPECT_TRUE(o.enable_dynamic_removal);
   EXPECT_EQ(o.enhancement_levels, 1);
@@ -34,6 +35,8 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_DOUBLE_EQ(o.z_th_m, 20);
   EXPECT_DOUBLE_EQ(o.drop_probability, 0.25);
   EXPECT_EQ(o.seed, 7u);
+  EXPECT_FALSE(o.stage1_motion_compensation);
+  EXPECT_TRUE(FilterOptions{}.stage1_motion_compensation);
   EXPECT_DOUBLE_EQ(o.d_dis_px, 8.0);  // default kept
   EXPECT_EQ(FilterOptions::FromYaml(YAML::Node()).background_matches_t, 20);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{drop_probability: 1.5}")),
@@ -46,6 +49,8 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{enhancement_keep_ratio: 0}")),
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{dynamic_class_ids: person}")),
+               std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{stage1_motion_compensation: maybe}")),
                std::invalid_argument);
   FilterOptions bad;
   bad.background_matches_t = 0;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <stdexcept>
 
 #include "ademono/feature/matching.h"
@@ -39,6 +41,55 @@ std::vector<GrownBox> GrowDynamicBoxes(const std::vector<Detection>& detections,
     boxes.push_back(grown);
   }
   return boxes;
+}
+
+std::optional<Rigid3d> FitBackgroundMotion(const std::vector<cv::KeyPoint>& keypoints,
+                                           const PreviousFrameFeatures& previous,
+                                           const std::vector<cv::DMatch>& matches,
+                                           const std::vector<char>& in_box, const Camera& camera,
+                                           const DynamicParams& params, int* num_inliers) {
+  std::vector<cv::Point3f> object;
+  std::vector<cv::Point2f> image;
+  for (const cv::DMatch& m : matches) {
+    const size_t i = static_cast<size_t>(m.queryIdx);
+    if (in_box[i]) continue;
+    const Eigen::Vector3d& x = previous.points_cam[static_cast<size_t>(m.trainIdx)];
+    const cv::Point2f& p = keypoints[i].pt;
+    if (!x.allFinite() || !(x.z() > 0.0) || !std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+    const Eigen::Vector2d un = camera.Undistort(Eigen::Vector2d(p.x, p.y));
+    object.emplace_back(static_cast<float>(x.x()), static_cast<float>(x.y()),
+                        static_cast<float>(x.z()));
+    image.emplace_back(static_cast<float>(un.x()), static_cast<float>(un.y()));
+  }
+  if (static_cast<int>(object.size()) < params.motion_min_inliers) return std::nullopt;
+  const cv::Mat K =
+      (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  // OpenCV's RANSAC seeds its own generator with a constant: deterministic for the same input.
+  if (!cv::solvePnPRansac(
+          object, image, K, cv::noArray(), rvec, tvec, false, params.motion_ransac_iterations,
+          static_cast<float>(params.motion_inlier_px), 0.99, inliers, cv::SOLVEPNP_EPNP) ||
+      static_cast<int>(inliers.size()) < params.motion_min_inliers)
+    return std::nullopt;
+  std::vector<cv::Point3f> inlier_object;
+  std::vector<cv::Point2f> inlier_image;
+  for (int k : inliers) {
+    inlier_object.push_back(object[static_cast<size_t>(k)]);
+    inlier_image.push_back(image[static_cast<size_t>(k)]);
+  }
+  cv::solvePnPRefineLM(inlier_object, inlier_image, K, cv::noArray(), rvec, tvec);
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d rotation;
+  cv::cv2eigen(R, rotation);
+  Rigid3d cur_from_prev = Rigid3d::Identity();
+  cur_from_prev.linear() = rotation;
+  cur_from_prev.translation() =
+      Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  if (!cur_from_prev.matrix().allFinite()) return std::nullopt;
+  if (num_inliers != nullptr) *num_inliers = static_cast<int>(inliers.size());
+  return cur_from_prev;
 }
 
 DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams& params) {
@@ -85,6 +136,9 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
   if (!prev.points_world.empty() && prev.points_world.size() != prev.keypoints.size())
     throw std::invalid_argument(
         "RemoveDynamicPoints: previous frame needs one world point per keypoint (NaN if none)");
+  if (!prev.points_cam.empty() && prev.points_cam.size() != prev.keypoints.size())
+    throw std::invalid_argument(
+        "RemoveDynamicPoints: previous frame needs one camera point per keypoint (NaN if none)");
 
   // Match the active current points to the previous frame.
   std::vector<int> query_to_point;
@@ -104,48 +158,89 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
     prev_of[static_cast<size_t>(m.queryIdx)] = m.trainIdx;
   }
 
-  // Background motion: mean displacement of the t closest matches outside every grown box.
-  std::vector<cv::DMatch> background;
+  // Stage 1's background motion model. The paper's: one mean image displacement. With motion
+  // compensation: the camera motion fitted to the background matches that have a depth in the
+  // previous frame (PnP + RANSAC), so each point is compared with where a static point at its
+  // depth would be now. Falls back to the paper's model when the fit is not possible.
   auto finite = [](const cv::Point2f& p) { return std::isfinite(p.x) && std::isfinite(p.y); };
-  for (const cv::DMatch& m : matches) {
-    // Non-finite positions would turn the mean into NaN and silently disable stage 1.
-    if (!in_any[static_cast<size_t>(m.queryIdx)] &&
-        finite(kps[static_cast<size_t>(m.queryIdx)].pt) &&
-        finite(prev.keypoints[static_cast<size_t>(m.trainIdx)].pt))
-      background.push_back(m);
-  }
-  std::stable_sort(
-      background.begin(), background.end(),
-      [](const cv::DMatch& a, const cv::DMatch& b) { return a.distance < b.distance; });
-  if (background.size() > static_cast<size_t>(params.background_matches_t))
-    background.resize(static_cast<size_t>(params.background_matches_t));
-  if (!background.empty()) {
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (const cv::DMatch& m : background) {
-      const cv::Point2f d = kps[static_cast<size_t>(m.queryIdx)].pt - prev.keypoints[m.trainIdx].pt;
-      sum += Eigen::Vector2d(d.x, d.y);
+  std::optional<Rigid3d> cur_from_prev;
+  if (params.stage1_motion_compensation && !prev.points_cam.empty())
+    cur_from_prev = FitBackgroundMotion(kps, prev, matches, in_any, *input.camera, params,
+                                        &result.num_motion_inliers);
+  result.motion_compensated = cur_from_prev.has_value();
+  if (input.depths != nullptr && input.depths->size() != n)
+    throw std::invalid_argument("RemoveDynamicPoints: one depth per keypoint expected");
+  const std::optional<Rigid3d> prev_from_cur =
+      cur_from_prev ? std::optional<Rigid3d>(cur_from_prev->inverse()) : std::nullopt;
+  auto displacement = [&](size_t i, int j) -> std::optional<Eigen::Vector2d> {
+    const cv::Point2f& q = prev.keypoints[static_cast<size_t>(j)].pt;
+    if (!finite(kps[i].pt) || !finite(q))
+      return std::nullopt;  // a NaN would poison the background mean and disable stage 1
+    const Eigen::Vector2d cur_px(kps[i].pt.x, kps[i].pt.y), prev_px(q.x, q.y);
+    if (!cur_from_prev) return cur_px - prev_px;
+    // Forward: the previous point moved with the camera, against where it is now.
+    const Eigen::Vector3d& x = prev.points_cam[static_cast<size_t>(j)];
+    if (x.allFinite()) {
+      const Eigen::Vector3d cam = *cur_from_prev * x;
+      if (!(cam.z() > 0.0)) return std::nullopt;
+      return cur_px - input.camera->Project(cam);
     }
-    result.background_motion = sum / static_cast<double>(background.size());
-    result.num_background_matches = static_cast<int>(background.size());
+    // Backward, from the current depth: where a static point would have been, against where it
+    // was (the same residual as forward, to first order).
+    if (input.depths == nullptr) return std::nullopt;
+    const float z = (*input.depths)[i];
+    if (!(z > 0.f) || !std::isfinite(z)) return std::nullopt;  // no depth in either frame
+    const Eigen::Vector3d cam =
+        *prev_from_cur * input.camera->Unproject(input.camera->Undistort(cur_px), z);
+    if (!(cam.z() > 0.0)) return std::nullopt;
+    return input.camera->Project(cam) - prev_px;
+  };
+
+  // Background motion: mean displacement of the t closest matches outside every grown box (with
+  // compensation, the mean residual of the fitted motion: near zero unless the fit is biased).
+  {
+    std::vector<std::pair<const cv::DMatch*, Eigen::Vector2d>> background;
+    for (const cv::DMatch& m : matches) {
+      const size_t i = static_cast<size_t>(m.queryIdx);
+      if (in_any[i]) continue;
+      if (const auto d = displacement(i, m.trainIdx)) background.emplace_back(&m, *d);
+    }
+    std::stable_sort(background.begin(), background.end(), [](const auto& a, const auto& b) {
+      return a.first->distance < b.first->distance;
+    });
+    if (background.size() > static_cast<size_t>(params.background_matches_t))
+      background.resize(static_cast<size_t>(params.background_matches_t));
+    if (!background.empty()) {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      for (const auto& [m, d] : background) sum += d;
+      result.background_motion = sum / static_cast<double>(background.size());
+      result.num_background_matches = static_cast<int>(background.size());
+    }
   }
 
+  // judged: the point got a verdict from stage 1 or 2 (the box vote counts only those).
+  std::vector<char> judged(n, 0);
   for (size_t i = 0; i < n; ++i) {
     if (!active(i) || !in_large[i] || result.labels[i] != PointLabel::kKept) continue;
     const int j = prev_of[i];
     if (j < 0) continue;  // unmatched: no evidence either way, kept
     // Stage 1: displacement against the background's.
     if (result.background_motion) {
-      const cv::Point2f d = kps[i].pt - prev.keypoints[static_cast<size_t>(j)].pt;
-      const Eigen::Vector2d diff = Eigen::Vector2d(d.x, d.y) - *result.background_motion;
-      if (diff.norm() > params.d_dis_px) {
-        result.labels[i] = PointLabel::kDynamicStage1;
-        continue;
+      if (const auto d = displacement(i, j)) {
+        judged[i] = 1;
+        if ((*d - *result.background_motion).norm() > params.d_dis_px) {
+          result.labels[i] = PointLabel::kDynamicStage1;
+          continue;
+        }
       }
+    } else {
+      judged[i] = 1;  // no background match at all: stage 1 passes the point
     }
     // Stage 2: where the previous world point should appear under the predicted pose.
     if (!input.predicted_cam_from_world || prev.points_world.empty()) continue;
     const Eigen::Vector3d& world = prev.points_world[static_cast<size_t>(j)];
     if (!world.allFinite()) continue;
+    judged[i] = 1;
     const Eigen::Vector3d cam = *input.predicted_cam_from_world * world;
     if (!(cam.z() > 0.0)) {
       // A static point seen last frame cannot jump behind the camera under smooth motion.
@@ -158,27 +253,27 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
       result.labels[i] = PointLabel::kDynamicStage2;
   }
 
-  // Box vote: a point without a match has no evidence of its own, but if enough of the matched
-  // points of its large box failed stage 1 or 2 the box holds a moving object, and the unmatched
-  // points (mostly on the object: its texture and silhouette change frame to frame) go with it.
-  // A static object's box (few failures) keeps its unmatched points.
+  // Box vote: a point without a verdict (no match, or nothing to compare it with) has no evidence
+  // of its own, but if enough of the judged points of its large box failed stage 1 or 2 the box
+  // holds a moving object, and the unjudged points (mostly on the object: its texture and
+  // silhouette change frame to frame) go with it. A static object's box keeps them.
   if (params.box_vote_ratio <= 1.0) {
     std::vector<char> moving_box(result.boxes.size(), 0);
     for (size_t b = 0; b < result.boxes.size(); ++b) {
       if (result.boxes[b].small) continue;
-      int judged = 0, dynamic = 0;
+      int num_judged = 0, num_dynamic = 0;
       for (size_t i = 0; i < n; ++i) {
-        if (!active(i) || prev_of[i] < 0 || !InsideBox(result.boxes[b].box, kps[i].pt)) continue;
-        ++judged;
+        if (!active(i) || !judged[i] || !InsideBox(result.boxes[b].box, kps[i].pt)) continue;
+        ++num_judged;
         if (result.labels[i] == PointLabel::kDynamicStage1 ||
             result.labels[i] == PointLabel::kDynamicStage2)
-          ++dynamic;
+          ++num_dynamic;
       }
-      moving_box[b] = judged >= params.box_vote_min_matches &&
-                      dynamic >= params.box_vote_ratio * static_cast<double>(judged);
+      moving_box[b] = num_judged >= params.box_vote_min_matches &&
+                      num_dynamic >= params.box_vote_ratio * static_cast<double>(num_judged);
     }
     for (size_t i = 0; i < n; ++i) {
-      if (!active(i) || !in_large[i] || prev_of[i] >= 0 || result.labels[i] != PointLabel::kKept)
+      if (!active(i) || !in_large[i] || judged[i] || result.labels[i] != PointLabel::kKept)
         continue;
       for (size_t b = 0; b < result.boxes.size(); ++b) {
         if (moving_box[b] && InsideBox(result.boxes[b].box, kps[i].pt)) {

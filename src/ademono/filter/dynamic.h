@@ -3,6 +3,14 @@
 // points in small boxes are dropped outright, points in large boxes go through a two-stage test:
 // (1) their frame-to-frame displacement against the background's, (2) the reprojection error of
 // their previous world point under the constant-velocity pose prediction. See docs/filters.md.
+//
+// Stage 1 by default measures displacements relative to the camera's own motion
+// (`stage1_motion_compensation`): the motion from the previous to the current camera is fitted
+// to the background matches (PnP + RANSAC on their previous-frame depths), and each point is
+// compared with where a static point at its depth would be now. Under forward motion the raw
+// image flow of static points grows with image position and inverse depth, so the paper's one
+// mean background displacement judges near static objects (parked cars) moving. Without enough
+// background points with depth, or with compensation off, stage 1 is the paper's raw test.
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -22,6 +30,11 @@ struct DynamicParams {
   int background_matches_t = 20;
   double d_dis_px = 8.0;
   double d_min_px = 4.0;
+  // Stage 1 against the camera motion fitted to the background (see above), not one mean shift.
+  bool stage1_motion_compensation = true;
+  int motion_min_inliers = 12;    // background matches the fit needs (and inliers it keeps)
+  double motion_inlier_px = 3.0;  // RANSAC reprojection threshold of the fit
+  int motion_ransac_iterations = 100;
   // Box vote for unmatched large-box points: a box is moving when at least this fraction of its
   // matched points (and at least box_vote_min_matches of them) failed stage 1 or 2. > 1 disables.
   double box_vote_ratio = 0.15;
@@ -54,15 +67,33 @@ struct DynamicInput {
   const PreviousFrameFeatures* previous = nullptr;
   const Camera* camera = nullptr;  // image size; projection for stage 2
   std::optional<Rigid3d> predicted_cam_from_world;
+  // Metres per current keypoint (<= 0 unknown), optional: with motion compensation a point whose
+  // previous match has no depth is checked backwards, from its current depth into the previous
+  // image.
+  const std::vector<float>* depths = nullptr;
 };
 
 struct DynamicResult {
   std::vector<PointLabel> labels;  // kKept or one of the kDynamic* labels; inactive stay kKept
   std::vector<GrownBox> boxes;
-  std::optional<Eigen::Vector2d> background_motion;  // mean (cur - prev) of the t best matches
-  int num_background_matches = 0;                    // used for background_motion (<= t)
+  // Mean displacement of the t best background matches: (cur - prev), or with motion
+  // compensation the mean residual (cur - fitted position of prev).
+  std::optional<Eigen::Vector2d> background_motion;
+  int num_background_matches = 0;   // used for background_motion (<= t)
+  bool motion_compensated = false;  // stage 1 used the fitted camera motion
+  int num_motion_inliers = 0;       // RANSAC inliers of that fit
 };
 
 DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams& params);
+
+// The motion from the previous to the current camera fitted to the matches whose current point is
+// outside every box (in_box[query] == 0) and whose previous point has a camera-frame position:
+// EPnP in RANSAC, then Levenberg-Marquardt on the inliers. nullopt with fewer than
+// params.motion_min_inliers points or inliers. matches: queryIdx current, trainIdx previous.
+std::optional<Rigid3d> FitBackgroundMotion(const std::vector<cv::KeyPoint>& keypoints,
+                                           const PreviousFrameFeatures& previous,
+                                           const std::vector<cv::DMatch>& matches,
+                                           const std::vector<char>& in_box, const Camera& camera,
+                                           const DynamicParams& params, int* num_inliers = nullptr);
 
 }  // namespace ademono

@@ -93,6 +93,8 @@ FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
       ReadYamlKey(node, "filter", "background_matches_t", o.background_matches_t);
   o.d_dis_px = ReadYamlKey(node, "filter", "d_dis_px", o.d_dis_px);
   o.d_min_px = ReadYamlKey(node, "filter", "d_min_px", o.d_min_px);
+  o.stage1_motion_compensation =
+      ReadYamlKey(node, "filter", "stage1_motion_compensation", o.stage1_motion_compensation);
   o.box_vote_ratio = ReadYamlKey(node, "filter", "box_vote_ratio", o.box_vote_ratio);
   o.box_vote_min_matches =
       ReadYamlKey(node, "filter", "box_vote_min_matches", o.box_vote_min_matches);
@@ -152,6 +154,7 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     params.background_matches_t = options_.background_matches_t;
     params.d_dis_px = options_.d_dis_px;
     params.d_min_px = options_.d_min_px;
+    params.stage1_motion_compensation = options_.stage1_motion_compensation;
     params.box_vote_ratio = options_.box_vote_ratio;
     params.box_vote_min_matches = options_.box_vote_min_matches;
     params.dynamic_class_ids = options_.dynamic_class_ids;
@@ -163,6 +166,7 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     dyn.previous = input.previous;
     dyn.camera = input.camera;
     dyn.predicted_cam_from_world = input.predicted_cam_from_world;
+    dyn.depths = input.depths;
     const DynamicResult result = RemoveDynamicPoints(dyn, params);
     for (size_t i = 0; i < n; ++i)
       if (labels[i] == PointLabel::kKept) labels[i] = result.labels[i];

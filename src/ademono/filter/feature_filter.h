@@ -42,13 +42,14 @@ struct FilterOptions {
   double enhancement_p_percent = -1;  // < 0: derived from the image size
   double enhancement_q_percent = -1;
   // Dynamic removal.
-  double box_growth = 0.02;            // d = box_growth * box diagonal
-  double small_box_area_ratio = 0.05;  // box area / image area below this: drop all inside
-  int background_matches_t = 20;       // t smallest-Hamming background matches
-  double d_dis_px = 8.0;               // stage 1 threshold (pixels)
-  double d_min_px = 4.0;               // stage 2 threshold (pixels)
-  double box_vote_ratio = 0.15;        // unmatched large-box points follow their box's verdict
-  int box_vote_min_matches = 5;        // (see filter/dynamic.h); box_vote_ratio > 1 disables
+  double box_growth = 0.02;                // d = box_growth * box diagonal
+  double small_box_area_ratio = 0.05;      // box area / image area below this: drop all inside
+  int background_matches_t = 20;           // t smallest-Hamming background matches
+  double d_dis_px = 8.0;                   // stage 1 threshold (pixels)
+  double d_min_px = 4.0;                   // stage 2 threshold (pixels)
+  bool stage1_motion_compensation = true;  // stage 1 relative to the predicted ego-motion flow
+  double box_vote_ratio = 0.15;            // unmatched large-box points follow their box's verdict
+  int box_vote_min_matches = 5;            // (see filter/dynamic.h); box_vote_ratio > 1 disables
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
   // Distant filter.
   double z_th_m = 30.0;
@@ -65,6 +66,9 @@ struct PreviousFrameFeatures {
   cv::Mat descriptors;
   // World position of each keypoint (from its depth and the frame's estimated pose); NaN if none.
   std::vector<Eigen::Vector3d> points_world;
+  // Position of each keypoint in that frame's camera, from its depth alone (known even when the
+  // frame was not tracked); NaN if no depth. Empty: stage 1 cannot compensate the camera motion.
+  std::vector<Eigen::Vector3d> points_cam;
 };
 
 struct FilterInput {

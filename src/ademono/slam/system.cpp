@@ -221,14 +221,14 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   previous.descriptors = descriptors.empty() ? cv::Mat(0, 32, CV_8UC1) : descriptors;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   previous.points_world.assign(keypoints.size(), Eigen::Vector3d(nan, nan, nan));
-  if (out.tracked) {
-    const Rigid3d world_from_cam = out.cam_from_world.inverse();
-    for (size_t i = 0; i < keypoints.size(); ++i) {
-      if (!(depths[i] > 0)) continue;
-      const Eigen::Vector2d un =
-          camera_.Undistort(Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y));
-      previous.points_world[i] = world_from_cam * camera_.Unproject(un, depths[i]);
-    }
+  previous.points_cam.assign(keypoints.size(), Eigen::Vector3d(nan, nan, nan));
+  const Rigid3d world_from_cam = out.tracked ? out.cam_from_world.inverse() : Rigid3d::Identity();
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    if (!(depths[i] > 0)) continue;
+    const Eigen::Vector2d un =
+        camera_.Undistort(Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y));
+    previous.points_cam[i] = camera_.Unproject(un, depths[i]);
+    if (out.tracked) previous.points_world[i] = world_from_cam * previous.points_cam[i];
   }
   previous_ = std::move(previous);
 
