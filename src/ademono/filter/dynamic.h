@@ -35,8 +35,9 @@ struct DynamicParams {
   int motion_min_inliers = 12;    // background matches the fit needs (and inliers it keeps)
   double motion_inlier_px = 3.0;  // RANSAC reprojection threshold of the fit
   int motion_ransac_iterations = 100;
-  // Box vote for unmatched large-box points: a box is moving when at least this fraction of its
-  // matched points (and at least box_vote_min_matches of them) failed stage 1 or 2. > 1 disables.
+  // Box vote for large-box points without a stage-1/2 verdict: a box is moving when at least this
+  // fraction of its judged points (and at least box_vote_min_matches of them) failed stage 1 or 2.
+  // > 1 disables.
   double box_vote_ratio = 0.15;
   int box_vote_min_matches = 5;
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
