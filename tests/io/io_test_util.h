@@ -8,8 +8,31 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <system_error>
+#include <vector>
 
 namespace ademono::testing {
+
+// The directories MakeTempDir made, removed when the test program exits (passed or failed), so
+// repeated test runs do not pile up directories in /tmp.
+class TempDirRegistry {
+ public:
+  ~TempDirRegistry() {
+    for (const auto& dir : dirs_) {
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+  void Add(const std::filesystem::path& dir) { dirs_.push_back(dir); }
+
+ private:
+  std::vector<std::filesystem::path> dirs_;
+};
+
+inline TempDirRegistry& TempDirs() {
+  static TempDirRegistry registry;
+  return registry;
+}
 
 inline std::filesystem::path MakeTempDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
@@ -18,6 +41,7 @@ inline std::filesystem::path MakeTempDir() {
                                info->name() + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  TempDirs().Add(dir);
   return dir;
 }
 
