@@ -100,6 +100,8 @@ TEST(FeatureFilterTest, FiltersApplyInOrderAndStatsAddUp) {
   EXPECT_EQ(stats.removed_enhancement, 16 * 3);
   EXPECT_EQ(stats.boxes_small, 1);
   EXPECT_EQ(stats.boxes_large, 0);
+  EXPECT_EQ(stats.stage1_ran, 0);  // no large box, no previous frame
+  EXPECT_EQ(stats.stage1_compensated, 0);
   // Grown box (8.9, 8.9)-(51.1, 51.1) holds (20, 20) only; it is removed unless enhancement dropped
   // it.
   const int small = labels[0] == PointLabel::kDynamicSmallBox ? 1 : 0;

@@ -137,6 +137,8 @@ TEST_P(RealFramesTest, StaticSceneKeepsAlmostEverythingInTheBox) {
   FilterStats stats;
   filter.Apply(Input(), &stats);
   EXPECT_EQ(stats.boxes_large, 1);
+  EXPECT_EQ(stats.stage1_ran, 1);
+  EXPECT_EQ(stats.stage1_compensated, GetParam() ? 1 : 0);
   const int inside = InsideBox();
   RecordProperty("inside", inside);
   RecordProperty("stage1", stats.removed_stage1);

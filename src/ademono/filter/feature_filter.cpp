@@ -171,6 +171,8 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     for (size_t i = 0; i < n; ++i)
       if (labels[i] == PointLabel::kKept) labels[i] = result.labels[i];
     for (const GrownBox& b : result.boxes) (b.small ? s.boxes_small : s.boxes_large)++;
+    s.stage1_ran = result.background_motion.has_value() ? 1 : 0;
+    s.stage1_compensated = s.stage1_ran && result.motion_compensated ? 1 : 0;
   }
 
   if (options_.enable_distant_filter && !depths.empty()) {

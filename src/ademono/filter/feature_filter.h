@@ -94,6 +94,11 @@ struct FilterStats {
   // removed_distant / distant_candidates is the realised drop rate.
   int distant_candidates = 0;
   int kept = 0;
+  // 1 when stage 1 ran this frame (a large box and a previous frame with background matches),
+  // and when it compared against the camera motion fitted to the background (else the paper's
+  // mean displacement).
+  int stage1_ran = 0;
+  int stage1_compensated = 0;
 };
 
 class FeatureFilter {

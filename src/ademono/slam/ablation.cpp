@@ -38,6 +38,8 @@ void FilterTotals::Add(const FilterStats& s, int num_keypoints) {
   distant_candidates += s.distant_candidates;
   kept += s.kept;
   keypoints += num_keypoints;
+  stage1_frames += s.stage1_ran;
+  stage1_compensated_frames += s.stage1_compensated;
 }
 
 nlohmann::json FilterTotals::ToJson() const {
@@ -52,7 +54,9 @@ nlohmann::json FilterTotals::ToJson() const {
                    {"removed_box_vote", removed_box_vote},
                    {"removed_dynamic", RemovedDynamic()},
                    {"removed_distant", removed_distant},
-                   {"distant_candidates", distant_candidates}};
+                   {"distant_candidates", distant_candidates},
+                   {"stage1_frames", stage1_frames},
+                   {"stage1_compensated_frames", stage1_compensated_frames}};
   j["distant_drop_rate"] =
       distant_candidates > 0
           ? nlohmann::json(static_cast<double>(removed_distant) / distant_candidates)
@@ -70,6 +74,7 @@ nlohmann::json FilterStatsJson(const FilterStats& s) {
           {"removed_box_vote", s.removed_box_vote},
           {"removed_distant", s.removed_distant},
           {"distant_candidates", s.distant_candidates},
+          {"stage1_compensated", s.stage1_compensated},
           {"kept", s.kept}};
 }
 

@@ -39,6 +39,7 @@ struct FilterTotals {
   long long removed_enhancement = 0, removed_small_box = 0, removed_stage1 = 0, removed_stage2 = 0;
   long long removed_box_vote = 0;
   long long removed_distant = 0, distant_candidates = 0, kept = 0, keypoints = 0;
+  long long stage1_frames = 0, stage1_compensated_frames = 0;
   void Add(const FilterStats& s, int num_keypoints);
   long long RemovedDynamic() const {
     return removed_small_box + removed_stage1 + removed_stage2 + removed_box_vote;
