@@ -88,7 +88,10 @@ nlohmann::json TruthCounts::ToJson() const {
           {"moving_removed_ratio", ratio(moving_removed, moving_keypoints)},
           {"static_person_keypoints", static_person_keypoints},
           {"static_person_removed", static_person_removed},
-          {"static_person_removed_ratio", ratio(static_person_removed, static_person_keypoints)}};
+          {"static_person_removed_ratio", ratio(static_person_removed, static_person_keypoints)},
+          {"static_in_box_keypoints", static_in_box_keypoints},
+          {"static_in_box_removed", static_in_box_removed},
+          {"static_in_box_removed_ratio", ratio(static_in_box_removed, static_in_box_keypoints)}};
 }
 
 SyntheticTruth::SyntheticTruth(const fs::path& sequence_dir) : masks_dir_(sequence_dir / "masks") {
@@ -141,9 +144,21 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;
       if (labels[i] == PointLabel::kKept) ++counts->moving_kept;
-    } else if (static_box && static_box->contains(p)) {
-      ++counts->static_person_keypoints;
-      if (dynamic) ++counts->static_person_removed;
+    } else {
+      if (static_box && static_box->contains(p)) {
+        ++counts->static_person_keypoints;
+        if (dynamic) ++counts->static_person_removed;
+      }
+      const auto& classes = DefaultDynamicClassIds();
+      const bool in_box =
+          std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
+            return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
+                   d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
+          });
+      if (in_box) {
+        ++counts->static_in_box_keypoints;
+        if (dynamic) ++counts->static_in_box_removed;
+      }
     }
   }
 }

@@ -57,6 +57,10 @@ struct TruthCounts {
   long long moving_kept = 0;              // ... labelled kept (used for tracking)
   long long static_person_keypoints = 0;  // in the static person box, not on a moving object
   long long static_person_removed = 0;    // ... labelled dynamic
+  // In any box of a dynamic class (the detector's box, not grown) but not on a moving object:
+  // static objects such as parked cars, and background seen inside boxes.
+  long long static_in_box_keypoints = 0;
+  long long static_in_box_removed = 0;  // ... labelled dynamic
   nlohmann::json ToJson() const;
 };
 
