@@ -195,6 +195,7 @@ void BM_FeatureFilter(benchmark::State& state) {
   const std::vector<ademono::Detection> detections{box};
   ademono::FilterOptions options;
   options.z_th_m = 2.0;  // indoor scene: make the distant filter draw too
+  options.stage1_motion_compensation = state.range(0) != 0;  // 0: the paper's stage 1
   ademono::FeatureFilter filter(options);
   ademono::FilterInput input;
   input.camera = &camera;
@@ -213,7 +214,7 @@ void BM_FeatureFilter(benchmark::State& state) {
   state.counters["stage2"] = stats.removed_stage2;
   state.counters["distant"] = stats.removed_distant;
 }
-BENCHMARK(BM_FeatureFilter)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FeatureFilter)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
