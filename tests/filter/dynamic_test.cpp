@@ -64,6 +64,18 @@ TEST(GrowDynamicBoxesTest, GrowthClippingSizeClassAndClassFilter) {
   EXPECT_FALSE(InsideBox(cv::Rect2f(0, 0, 10, 10), cv::Point2f(10, 5)));
 }
 
+DynamicInput MakeInput(const std::vector<cv::KeyPoint>& cur, const cv::Mat& cur_desc,
+                       const std::vector<Detection>& detections,
+                       const PreviousFrameFeatures& previous, const Camera& camera) {
+  DynamicInput in;
+  in.keypoints = &cur;
+  in.descriptors = &cur_desc;
+  in.detections = &detections;
+  in.previous = &previous;
+  in.camera = &camera;
+  return in;
+}
+
 // A scene with one small and one large dynamic box, background points moving by (2, 1) between
 // frames, and large-box points exercising each branch of the two-stage test.
 struct Scene {
@@ -123,12 +135,7 @@ struct Scene {
   }
 
   DynamicInput Input() const {
-    DynamicInput in;
-    in.keypoints = &cur;
-    in.descriptors = &cur_desc;
-    in.detections = &detections;
-    in.previous = &previous;
-    in.camera = &camera;
+    DynamicInput in = MakeInput(cur, cur_desc, detections, previous, camera);
     in.predicted_cam_from_world = predicted;
     return in;
   }
@@ -283,12 +290,7 @@ struct ForwardScene {
   }
 
   DynamicInput Input() const {
-    DynamicInput in;
-    in.keypoints = &cur;
-    in.descriptors = &cur_desc;
-    in.detections = &detections;
-    in.previous = &previous;
-    in.camera = &camera;
+    DynamicInput in = MakeInput(cur, cur_desc, detections, previous, camera);
     in.depths = &cur_depths;
     return in;  // no constant-velocity prediction: stage 2 does not run
   }

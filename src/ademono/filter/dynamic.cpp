@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <stdexcept>
 
+#include "ademono/core/cv_geometry.h"
 #include "ademono/feature/matching.h"
 
 namespace ademono {
@@ -79,14 +79,7 @@ std::optional<Rigid3d> FitBackgroundMotion(const std::vector<cv::KeyPoint>& keyp
     inlier_image.push_back(image[static_cast<size_t>(k)]);
   }
   cv::solvePnPRefineLM(inlier_object, inlier_image, K, cv::noArray(), rvec, tvec);
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d rotation;
-  cv::cv2eigen(R, rotation);
-  Rigid3d cur_from_prev = Rigid3d::Identity();
-  cur_from_prev.linear() = rotation;
-  cur_from_prev.translation() =
-      Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  const Rigid3d cur_from_prev = RigidFromRodrigues(rvec, tvec);
   if (!cur_from_prev.matrix().allFinite()) return std::nullopt;
   if (num_inliers != nullptr) *num_inliers = static_cast<int>(inliers.size());
   return cur_from_prev;

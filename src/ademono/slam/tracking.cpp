@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <map>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 
+#include "ademono/core/cv_geometry.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
 
@@ -427,15 +427,7 @@ bool Tracking::Relocalise(Frame& frame) {
         inliers.size() < 10) {
       continue;
     }
-    cv::Mat R;
-    cv::Rodrigues(rvec, R);
-    Eigen::Matrix3d rotation;
-    cv::cv2eigen(R, rotation);
-    Rigid3d pose = Rigid3d::Identity();
-    pose.linear() = rotation;
-    pose.translation() =
-        Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-    frame.cam_from_world = pose;
+    frame.cam_from_world = RigidFromRodrigues(rvec, tvec);
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
     for (int k : inliers) frame.map_points[indices[k]] = matches[indices[k]];
 
