@@ -195,7 +195,7 @@ void BM_FeatureFilter(benchmark::State& state) {
   const std::vector<ademono::Detection> detections{box};
   ademono::FilterOptions options;
   options.z_th_m = 2.0;  // indoor scene: make the distant filter draw too
-  options.stage1_motion_compensation = state.range(0) != 0;  // 0: the paper's stage 1
+  options.dynamic.stage1_motion_compensation = state.range(0) != 0;  // 0: the paper's stage 1
   ademono::FeatureFilter filter(options);
   ademono::FilterInput input;
   input.camera = &camera;

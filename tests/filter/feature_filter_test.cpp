@@ -30,15 +30,15 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_FALSE(o.enable_enhancement);
   EXPECT_TRUE(o.enable_dynamic_removal);
   EXPECT_EQ(o.enhancement_levels, 1);
-  EXPECT_DOUBLE_EQ(o.box_growth, 0.05);
-  EXPECT_EQ(o.dynamic_class_ids, std::vector<int>({0, 2}));
+  EXPECT_DOUBLE_EQ(o.dynamic.box_growth, 0.05);
+  EXPECT_EQ(o.dynamic.dynamic_class_ids, std::vector<int>({0, 2}));
   EXPECT_DOUBLE_EQ(o.z_th_m, 20);
   EXPECT_DOUBLE_EQ(o.drop_probability, 0.25);
   EXPECT_EQ(o.seed, 7u);
-  EXPECT_FALSE(o.stage1_motion_compensation);
-  EXPECT_TRUE(FilterOptions{}.stage1_motion_compensation);
-  EXPECT_DOUBLE_EQ(o.d_dis_px, 8.0);  // default kept
-  EXPECT_EQ(FilterOptions::FromYaml(YAML::Node()).background_matches_t, 20);
+  EXPECT_FALSE(o.dynamic.stage1_motion_compensation);
+  EXPECT_TRUE(FilterOptions{}.dynamic.stage1_motion_compensation);
+  EXPECT_DOUBLE_EQ(o.dynamic.d_dis_px, 8.0);  // default kept
+  EXPECT_EQ(FilterOptions::FromYaml(YAML::Node()).dynamic.background_matches_t, 20);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{drop_probability: 1.5}")),
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{z_th_m: far}")), std::invalid_argument);
@@ -52,8 +52,16 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{stage1_motion_compensation: maybe}")),
                std::invalid_argument);
+  EXPECT_EQ(
+      FilterOptions::FromYaml(YAML::Load("{motion_min_inliers: 20}")).dynamic.motion_min_inliers,
+      20);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_min_inliers: 3}")),
+               std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_inlier_px: 0}")), std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_ransac_iterations: 0}")),
+               std::invalid_argument);
   FilterOptions bad;
-  bad.background_matches_t = 0;
+  bad.dynamic.background_matches_t = 0;
   EXPECT_THROW(FeatureFilter{bad}, std::invalid_argument);
 }
 

@@ -114,7 +114,7 @@ class RealFramesTest : public ::testing::TestWithParam<bool> {
   static FilterOptions DynamicOnly() {
     FilterOptions o;
     o.enable_enhancement = o.enable_distant_filter = false;
-    o.stage1_motion_compensation = GetParam();
+    o.dynamic.stage1_motion_compensation = GetParam();
     return o;
   }
 

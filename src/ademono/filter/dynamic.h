@@ -20,31 +20,10 @@
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
 #include "ademono/detect/detection.h"
+#include "ademono/filter/dynamic_params.h"
 #include "ademono/filter/feature_filter.h"
 
 namespace ademono {
-
-struct DynamicParams {
-  double box_growth = 0.02;
-  double small_box_area_ratio = 0.05;
-  int background_matches_t = 20;
-  double d_dis_px = 8.0;
-  double d_min_px = 4.0;
-  // Stage 1 against the camera motion fitted to the background (see above), not one mean shift.
-  bool stage1_motion_compensation = true;
-  int motion_min_inliers = 12;    // background matches the fit needs (and inliers it keeps)
-  double motion_inlier_px = 3.0;  // RANSAC reprojection threshold of the fit
-  int motion_ransac_iterations = 100;
-  // Box vote for large-box points without a stage-1/2 verdict: a box is moving when at least this
-  // fraction of its judged points (and at least box_vote_min_matches of them) failed stage 1 or 2.
-  // > 1 disables.
-  double box_vote_ratio = 0.15;
-  int box_vote_min_matches = 5;
-  std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
-  // Frame-to-frame matching for stage 1 (not in FilterOptions: ORB-SLAM's usual values).
-  double match_ratio = 0.8;
-  int match_max_distance = 100;
-};
 
 struct GrownBox {
   cv::Rect2f box;            // grown by d = box_growth * diagonal on every side, clipped

@@ -38,18 +38,7 @@ const char* PointLabelName(PointLabel label) {
   return "unknown";
 }
 
-void FilterOptions::Check() const {
-  Require(
-      enhancement_keep_ratio > 0 && enhancement_keep_ratio <= 1,
-      "enhancement_keep_ratio must be in (0, 1], got " + std::to_string(enhancement_keep_ratio));
-  Require(enhancement_levels >= 0 && enhancement_levels <= 6,
-          "enhancement_levels must be in [0, 6], got " + std::to_string(enhancement_levels));
-  Require(std::isfinite(enhancement_p_percent) && enhancement_p_percent != 0,
-          "enhancement_p_percent must be > 0 (or < 0 for the default), got " +
-              std::to_string(enhancement_p_percent));
-  Require(std::isfinite(enhancement_q_percent) && enhancement_q_percent != 0,
-          "enhancement_q_percent must be > 0 (or < 0 for the default), got " +
-              std::to_string(enhancement_q_percent));
+void DynamicParams::Check() const {
   Require(box_growth >= 0 && box_growth <= 1,
           "box_growth must be in [0, 1], got " + std::to_string(box_growth));
   Require(small_box_area_ratio >= 0 && small_box_area_ratio <= 1,
@@ -65,6 +54,27 @@ void FilterOptions::Check() const {
       "box_vote_ratio must be >= 0 (> 1 disables the vote), got " + std::to_string(box_vote_ratio));
   Require(box_vote_min_matches >= 1,
           "box_vote_min_matches must be >= 1, got " + std::to_string(box_vote_min_matches));
+  Require(motion_min_inliers >= 4,
+          "motion_min_inliers must be >= 4, got " + std::to_string(motion_min_inliers));
+  Require(motion_inlier_px > 0 && std::isfinite(motion_inlier_px),
+          "motion_inlier_px must be > 0, got " + std::to_string(motion_inlier_px));
+  Require(motion_ransac_iterations >= 1,
+          "motion_ransac_iterations must be >= 1, got " + std::to_string(motion_ransac_iterations));
+}
+
+void FilterOptions::Check() const {
+  Require(
+      enhancement_keep_ratio > 0 && enhancement_keep_ratio <= 1,
+      "enhancement_keep_ratio must be in (0, 1], got " + std::to_string(enhancement_keep_ratio));
+  Require(enhancement_levels >= 0 && enhancement_levels <= 6,
+          "enhancement_levels must be in [0, 6], got " + std::to_string(enhancement_levels));
+  Require(std::isfinite(enhancement_p_percent) && enhancement_p_percent != 0,
+          "enhancement_p_percent must be > 0 (or < 0 for the default), got " +
+              std::to_string(enhancement_p_percent));
+  Require(std::isfinite(enhancement_q_percent) && enhancement_q_percent != 0,
+          "enhancement_q_percent must be > 0 (or < 0 for the default), got " +
+              std::to_string(enhancement_q_percent));
+  dynamic.Check();
   Require(z_th_m > 0 && std::isfinite(z_th_m), "z_th_m must be > 0, got " + std::to_string(z_th_m));
   Require(drop_probability >= 0 && drop_probability <= 1,
           "drop_probability must be in [0, 1], got " + std::to_string(drop_probability));
@@ -86,19 +96,27 @@ FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
       ReadYamlKey(node, "filter", "enhancement_p_percent", o.enhancement_p_percent);
   o.enhancement_q_percent =
       ReadYamlKey(node, "filter", "enhancement_q_percent", o.enhancement_q_percent);
-  o.box_growth = ReadYamlKey(node, "filter", "box_growth", o.box_growth);
-  o.small_box_area_ratio =
-      ReadYamlKey(node, "filter", "small_box_area_ratio", o.small_box_area_ratio);
-  o.background_matches_t =
-      ReadYamlKey(node, "filter", "background_matches_t", o.background_matches_t);
-  o.d_dis_px = ReadYamlKey(node, "filter", "d_dis_px", o.d_dis_px);
-  o.d_min_px = ReadYamlKey(node, "filter", "d_min_px", o.d_min_px);
-  o.stage1_motion_compensation =
-      ReadYamlKey(node, "filter", "stage1_motion_compensation", o.stage1_motion_compensation);
-  o.box_vote_ratio = ReadYamlKey(node, "filter", "box_vote_ratio", o.box_vote_ratio);
-  o.box_vote_min_matches =
-      ReadYamlKey(node, "filter", "box_vote_min_matches", o.box_vote_min_matches);
-  o.dynamic_class_ids = ReadYamlKey(node, "filter", "dynamic_class_ids", o.dynamic_class_ids);
+  o.dynamic.box_growth = ReadYamlKey(node, "filter", "box_growth", o.dynamic.box_growth);
+  o.dynamic.small_box_area_ratio =
+      ReadYamlKey(node, "filter", "small_box_area_ratio", o.dynamic.small_box_area_ratio);
+  o.dynamic.background_matches_t =
+      ReadYamlKey(node, "filter", "background_matches_t", o.dynamic.background_matches_t);
+  o.dynamic.d_dis_px = ReadYamlKey(node, "filter", "d_dis_px", o.dynamic.d_dis_px);
+  o.dynamic.d_min_px = ReadYamlKey(node, "filter", "d_min_px", o.dynamic.d_min_px);
+  o.dynamic.stage1_motion_compensation = ReadYamlKey(node, "filter", "stage1_motion_compensation",
+                                                     o.dynamic.stage1_motion_compensation);
+  o.dynamic.box_vote_ratio =
+      ReadYamlKey(node, "filter", "box_vote_ratio", o.dynamic.box_vote_ratio);
+  o.dynamic.box_vote_min_matches =
+      ReadYamlKey(node, "filter", "box_vote_min_matches", o.dynamic.box_vote_min_matches);
+  o.dynamic.dynamic_class_ids =
+      ReadYamlKey(node, "filter", "dynamic_class_ids", o.dynamic.dynamic_class_ids);
+  o.dynamic.motion_min_inliers =
+      ReadYamlKey(node, "filter", "motion_min_inliers", o.dynamic.motion_min_inliers);
+  o.dynamic.motion_inlier_px =
+      ReadYamlKey(node, "filter", "motion_inlier_px", o.dynamic.motion_inlier_px);
+  o.dynamic.motion_ransac_iterations =
+      ReadYamlKey(node, "filter", "motion_ransac_iterations", o.dynamic.motion_ransac_iterations);
   o.z_th_m = ReadYamlKey(node, "filter", "z_th_m", o.z_th_m);
   o.drop_probability = ReadYamlKey(node, "filter", "drop_probability", o.drop_probability);
   o.seed = ReadYamlKey(node, "filter", "seed", o.seed);
@@ -148,16 +166,6 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
   }
 
   if (options_.enable_dynamic_removal) {
-    DynamicParams params;
-    params.box_growth = options_.box_growth;
-    params.small_box_area_ratio = options_.small_box_area_ratio;
-    params.background_matches_t = options_.background_matches_t;
-    params.d_dis_px = options_.d_dis_px;
-    params.d_min_px = options_.d_min_px;
-    params.stage1_motion_compensation = options_.stage1_motion_compensation;
-    params.box_vote_ratio = options_.box_vote_ratio;
-    params.box_vote_min_matches = options_.box_vote_min_matches;
-    params.dynamic_class_ids = options_.dynamic_class_ids;
     DynamicInput dyn;
     dyn.keypoints = &kps;
     dyn.descriptors = input.descriptors;
@@ -167,7 +175,7 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     dyn.camera = input.camera;
     dyn.predicted_cam_from_world = input.predicted_cam_from_world;
     dyn.depths = input.depths;
-    const DynamicResult result = RemoveDynamicPoints(dyn, params);
+    const DynamicResult result = RemoveDynamicPoints(dyn, options_.dynamic);
     for (size_t i = 0; i < n; ++i)
       if (labels[i] == PointLabel::kKept) labels[i] = result.labels[i];
     for (const GrownBox& b : result.boxes) (b.small ? s.boxes_small : s.boxes_large)++;

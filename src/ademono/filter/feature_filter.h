@@ -17,6 +17,7 @@
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
 #include "ademono/detect/detection.h"
+#include "ademono/filter/dynamic_params.h"
 
 namespace ademono {
 
@@ -41,16 +42,7 @@ struct FilterOptions {
   // P and Q (percent) scale the weight; documented in docs/filters.md.
   double enhancement_p_percent = -1;  // < 0: derived from the image size
   double enhancement_q_percent = -1;
-  // Dynamic removal.
-  double box_growth = 0.02;                // d = box_growth * box diagonal
-  double small_box_area_ratio = 0.05;      // box area / image area below this: drop all inside
-  int background_matches_t = 20;           // t smallest-Hamming background matches
-  double d_dis_px = 8.0;                   // stage 1 threshold (pixels)
-  double d_min_px = 4.0;                   // stage 2 threshold (pixels)
-  bool stage1_motion_compensation = true;  // stage 1 relative to the predicted ego-motion flow
-  double box_vote_ratio = 0.15;            // unmatched large-box points follow their box's verdict
-  int box_vote_min_matches = 5;            // (see filter/dynamic.h); box_vote_ratio > 1 disables
-  std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
+  DynamicParams dynamic;  // dynamic removal (filter/dynamic_params.h)
   // Distant filter.
   double z_th_m = 30.0;
   double drop_probability = 0.5;

@@ -62,12 +62,8 @@ cv::Mat DrawFilterResult(const cv::Mat& image, const std::vector<cv::KeyPoint>& 
   else
     canvas = image.clone();
 
-  DynamicParams params;
-  params.box_growth = options.box_growth;
-  params.small_box_area_ratio = options.small_box_area_ratio;
-  params.dynamic_class_ids = options.dynamic_class_ids;
   const cv::Scalar box_color(255, 128, 0);
-  for (const GrownBox& b : GrowDynamicBoxes(detections, canvas.size(), params)) {
+  for (const GrownBox& b : GrowDynamicBoxes(detections, canvas.size(), options.dynamic)) {
     const cv::Point2f tl(b.box.x, b.box.y), br(b.box.x + b.box.width, b.box.y + b.box.height);
     const cv::Point2f tr(br.x, tl.y), bl(tl.x, br.y);
     if (b.small) {

@@ -171,7 +171,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
                  labels[i] == PointLabel::kDynamicStage2 ||
                  labels[i] == PointLabel::kDynamicBoxVote;
     }
-    if (judged > 0 && dynamic >= options_.filter.box_vote_ratio * judged)
+    if (judged > 0 && dynamic >= options_.filter.dynamic.box_vote_ratio * judged)
       moving_detections.push_back(d);
   }
   TrackingOutput out;

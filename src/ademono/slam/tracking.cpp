@@ -280,7 +280,7 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
   }
   // Map points that keep projecting into boxes of dynamic objects are probably on them.
   if (options_.filter.enable_dynamic_removal && !detections.empty()) {
-    const auto& classes = options_.filter.dynamic_class_ids;
+    const auto& classes = options_.filter.dynamic.dynamic_class_ids;
     for (size_t k = 0; k < candidates.size(); ++k) {
       for (const Detection& d : detections) {
         if (!classes.empty() &&

@@ -1,0 +1,36 @@
+#pragma once
+// Parameters of dynamic interference removal (filter/dynamic.h), the `dynamic` part of
+// FilterOptions. Read from the flat `filter:` YAML node (filter.box_growth, ...; docs/filters.md).
+
+#include <vector>
+
+#include "ademono/detect/detection.h"
+
+namespace ademono {
+
+struct DynamicParams {
+  double box_growth = 0.02;            // d = box_growth * box diagonal on every side
+  double small_box_area_ratio = 0.05;  // box area / image area below this: drop all inside
+  int background_matches_t = 20;       // t smallest-Hamming background matches
+  double d_dis_px = 8.0;               // stage 1 threshold D_dis (pixels)
+  double d_min_px = 4.0;               // stage 2 threshold D_min (pixels)
+  // Stage 1 against the camera motion fitted to the background (PnP on previous depths), not the
+  // paper's one mean displacement, which misjudges static objects under forward motion.
+  bool stage1_motion_compensation = true;
+  int motion_min_inliers = 12;    // background matches the fit needs (and inliers it keeps)
+  double motion_inlier_px = 3.0;  // RANSAC reprojection threshold of the fit
+  int motion_ransac_iterations = 100;
+  // Box vote for large-box points without a stage-1/2 verdict: a box is moving when at least this
+  // fraction of its judged points (and at least box_vote_min_matches of them) failed stage 1 or 2.
+  // > 1 disables.
+  double box_vote_ratio = 0.15;
+  int box_vote_min_matches = 5;
+  std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
+  // Frame-to-frame matching for stage 1 (ORB-SLAM's usual values; not in the YAML).
+  double match_ratio = 0.8;
+  int match_max_distance = 100;
+
+  void Check() const;  // throws std::invalid_argument("filter.<key> ...")
+};
+
+}  // namespace ademono
