@@ -118,8 +118,11 @@ TEST(SystemOptionsTest, YamlErrorsNameTheFile) {
       EXPECT_NE(message.find(needle), std::string::npos) << message;
     }
   };
-  expect_error("tracking:\n  min_inliers: many\n", "min_inliers");
-  expect_error("tracking:\n  bogus_key: 1\n", "bogus_key");
+  expect_error("tracking:\n  min_inliers: many\n", "tracking.min_inliers: cannot parse 'many'");
+  expect_error("tracking:\n  bogus_key: 1\n", "unknown key 'tracking.bogus_key'");
+  expect_error("optimizer:\n  pose_rounds: [1, 2]\n",
+               "optimizer.pose_rounds: cannot parse '[1, 2]'");
+  expect_error("mapping: [1]\n", "'mapping' must be a map");
   expect_error("depth:\n  min_depth: 5\n  max_depth: 1\n", "min_depth");
   expect_error("nonsense_section: {}\n", "nonsense_section");
   const SystemOptions ok =

@@ -2,67 +2,31 @@
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <set>
 #include <stdexcept>
 
 #include "ademono/core/error.h"
+#include "ademono/core/yaml_util.h"
 
 namespace ademono {
 namespace {
 
-void RequireKnownKeys(const YAML::Node& node, const std::set<std::string>& keys,
-                      const std::string& where, const std::filesystem::path& path) {
-  if (!node) return;
-  if (!node.IsMap()) ThrowInputError(path, "'" + where + "' must be a mapping");
-  for (const auto& item : node) {
-    const std::string key = item.first.as<std::string>();
-    if (!keys.count(key)) ThrowInputError(path, "unknown key '" + where + "." + key + "'");
+// input.mean, input.std, input.pad_value: one number for all channels or a list of 3.
+std::array<double, 3> ReadTriple(const YAML::Node& node, const char* key,
+                                 std::array<double, 3> value) {
+  constexpr const char* kExpected = "a number or a list of 3 numbers";
+  if (node && node.IsMap() && node[key] && node[key].IsScalar()) {
+    value.fill(ReadYamlKey(node, "input", key, 0.0, kExpected));
+    return value;
   }
+  return ReadYamlKey(node, "input", key, value, kExpected);
 }
 
-template <typename T>
-void Read(const YAML::Node& node, const char* key, const std::string& where,
-          const std::filesystem::path& path, T* value) {
-  if (!node || !node[key]) return;
-  try {
-    *value = node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    ThrowInputError(path, "'" + where + "." + key + "' has a bad value");
-  }
-}
-
-std::array<double, 3> ReadTriple(const YAML::Node& node, const char* key, const std::string& where,
-                                 const std::filesystem::path& path, std::array<double, 3> value) {
-  if (!node || !node[key]) return value;
-  const YAML::Node list = node[key];
-  try {
-    if (list.IsScalar()) {
-      value.fill(list.as<double>());
-    } else if (list.IsSequence() && list.size() == 3) {
-      for (int i = 0; i < 3; ++i) value[i] = list[i].as<double>();
-    } else {
-      ThrowInputError(path, "'" + where + "." + key + "' must be a number or a list of 3 numbers");
-    }
-  } catch (const YAML::Exception&) {
-    ThrowInputError(path, "'" + where + "." + key + "' must be a number or a list of 3 numbers");
-  }
-  return value;
-}
-
-template <typename E>
-E ReadChoice(const YAML::Node& node, const char* key, const std::string& where,
-             const std::filesystem::path& path,
-             const std::vector<std::pair<std::string, E>>& choices, E value) {
-  std::string text;
-  Read(node, key, where, path, &text);
-  if (text.empty()) return value;
-  std::string expected;
-  for (const auto& [name, choice] : choices) {
-    if (name == text) return choice;
-    expected += (expected.empty() ? "" : ", ") + name;
-  }
-  ThrowInputError(path,
-                  "'" + where + "." + key + "' is '" + text + "', expected one of " + expected);
+// Spec sections are maps when present; unlike the SLAM config, an empty `input:` is an error.
+void CheckSectionKeys(const YAML::Node& node, const char* section,
+                      std::initializer_list<std::string_view> keys) {
+  if (node && node.IsNull())
+    throw std::invalid_argument(std::string("'") + section + "' is empty, expected a map");
+  CheckYamlKeys(node, section, keys);
 }
 
 int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
@@ -123,70 +87,67 @@ void DepthModelSpec::Check() const {
 DepthModelSpec DepthModelSpec::FromYaml(const YAML::Node& node, const std::filesystem::path& path) {
   DepthModelSpec spec;
   if (!node || !node.IsMap()) ThrowInputError(path, "model spec must be a YAML mapping");
-  RequireKnownKeys(node, {"name", "input", "output"}, "spec", path);
-  Read(node, "name", "spec", path, &spec.name);
-  const YAML::Node in = node["input"];
-  RequireKnownKeys(in,
-                   {"resize", "width", "height", "side", "side_length", "multiple_of", "pad",
-                    "pad_value", "interpolation", "color", "units", "mean", "std"},
-                   "input", path);
-  spec.resize = ReadChoice<Resize>(in, "resize", "input", path,
-                                   {{"fixed", Resize::kFixed},
-                                    {"letterbox", Resize::kLetterbox},
-                                    {"multiple", Resize::kMultiple}},
-                                   spec.resize);
-  Read(in, "width", "input", path, &spec.width);
-  Read(in, "height", "input", path, &spec.height);
-  spec.long_side =
-      ReadChoice<bool>(in, "side", "input", path, {{"long", true}, {"short", false}}, true);
-  Read(in, "side_length", "input", path, &spec.side_length);
-  Read(in, "multiple_of", "input", path, &spec.multiple_of);
-  std::string pad_text;
-  Read(in, "pad", "input", path, &pad_text);
-  spec.pad_none = pad_text == "none";
-  if (!spec.pad_none) {
-    spec.pad = ReadChoice<PadPlacement>(in, "pad", "input", path,
-                                        {{"centre", PadPlacement::kCentre},
-                                         {"center", PadPlacement::kCentre},
-                                         {"bottom_right", PadPlacement::kTopLeft}},
-                                        spec.pad);
-  }
-  spec.pad_value = ReadTriple(in, "pad_value", "input", path, spec.pad_value);
-  spec.interpolation = ReadChoice<int>(in, "interpolation", "input", path,
-                                       {{"linear", cv::INTER_LINEAR},
-                                        {"cubic", cv::INTER_CUBIC},
-                                        {"area", cv::INTER_AREA},
-                                        {"nearest", cv::INTER_NEAREST}},
-                                       spec.interpolation);
-  spec.rgb = ReadChoice<bool>(in, "color", "input", path, {{"rgb", true}, {"bgr", false}}, true);
-  const bool unit = ReadChoice<bool>(in, "units", "input", path, {{"unit", true}, {"byte", false}},
-                                     /*default: mean/std in 0..1*/ true);
-  const double factor = unit ? 255.0 : 1.0;
-  std::array<double, 3> mean{0.485, 0.456, 0.406}, std{0.229, 0.224, 0.225};
-  if (!unit) {
-    for (int c = 0; c < 3; ++c) mean[c] *= 255, std[c] *= 255;
-  }
-  mean = ReadTriple(in, "mean", "input", path, mean);
-  std = ReadTriple(in, "std", "input", path, std);
-  for (int c = 0; c < 3; ++c) {
-    spec.mean[c] = mean[c] * factor;
-    spec.std[c] = std[c] * factor;
-  }
-
-  const YAML::Node out = node["output"];
-  RequireKnownKeys(out,
-                   {"kind", "scale", "baseline_focal", "canonical_focal", "min_depth", "max_depth"},
-                   "output", path);
-  spec.kind = ReadChoice<Kind>(
-      out, "kind", "output", path,
-      {{"metric", Kind::kMetric}, {"inverse", Kind::kInverse}, {"disparity", Kind::kDisparity}},
-      spec.kind);
-  Read(out, "scale", "output", path, &spec.scale);
-  Read(out, "baseline_focal", "output", path, &spec.baseline_focal);
-  Read(out, "canonical_focal", "output", path, &spec.canonical_focal);
-  Read(out, "min_depth", "output", path, &spec.min_depth);
-  Read(out, "max_depth", "output", path, &spec.max_depth);
   try {
+    CheckYamlKeys(node, "spec", {"name", "input", "output"});
+    spec.name = ReadYamlKey(node, "spec", "name", spec.name);
+    const YAML::Node in = node["input"];
+    CheckSectionKeys(in, "input",
+                     {"resize", "width", "height", "side", "side_length", "multiple_of", "pad",
+                      "pad_value", "interpolation", "color", "units", "mean", "std"});
+    spec.resize = ReadYamlChoice<Resize>(in, "input", "resize",
+                                         {{"fixed", Resize::kFixed},
+                                          {"letterbox", Resize::kLetterbox},
+                                          {"multiple", Resize::kMultiple}},
+                                         spec.resize);
+    spec.width = ReadYamlKey(in, "input", "width", spec.width);
+    spec.height = ReadYamlKey(in, "input", "height", spec.height);
+    spec.long_side =
+        ReadYamlChoice<bool>(in, "input", "side", {{"long", true}, {"short", false}}, true);
+    spec.side_length = ReadYamlKey(in, "input", "side_length", spec.side_length);
+    spec.multiple_of = ReadYamlKey(in, "input", "multiple_of", spec.multiple_of);
+    spec.pad_none = ReadYamlKey(in, "input", "pad", std::string()) == "none";
+    if (!spec.pad_none) {
+      spec.pad = ReadYamlChoice<PadPlacement>(in, "input", "pad",
+                                              {{"centre", PadPlacement::kCentre},
+                                               {"center", PadPlacement::kCentre},
+                                               {"bottom_right", PadPlacement::kTopLeft}},
+                                              spec.pad);
+    }
+    spec.pad_value = ReadTriple(in, "pad_value", spec.pad_value);
+    spec.interpolation = ReadYamlChoice<int>(in, "input", "interpolation",
+                                             {{"linear", cv::INTER_LINEAR},
+                                              {"cubic", cv::INTER_CUBIC},
+                                              {"area", cv::INTER_AREA},
+                                              {"nearest", cv::INTER_NEAREST}},
+                                             spec.interpolation);
+    spec.rgb = ReadYamlChoice<bool>(in, "input", "color", {{"rgb", true}, {"bgr", false}}, true);
+    const bool unit = ReadYamlChoice<bool>(in, "input", "units", {{"unit", true}, {"byte", false}},
+                                           /*default: mean/std in 0..1*/ true);
+    const double factor = unit ? 255.0 : 1.0;
+    std::array<double, 3> mean{0.485, 0.456, 0.406}, std{0.229, 0.224, 0.225};
+    if (!unit) {
+      for (int c = 0; c < 3; ++c) mean[c] *= 255, std[c] *= 255;
+    }
+    mean = ReadTriple(in, "mean", mean);
+    std = ReadTriple(in, "std", std);
+    for (int c = 0; c < 3; ++c) {
+      spec.mean[c] = mean[c] * factor;
+      spec.std[c] = std[c] * factor;
+    }
+
+    const YAML::Node out = node["output"];
+    CheckSectionKeys(
+        out, "output",
+        {"kind", "scale", "baseline_focal", "canonical_focal", "min_depth", "max_depth"});
+    spec.kind = ReadYamlChoice<Kind>(
+        out, "output", "kind",
+        {{"metric", Kind::kMetric}, {"inverse", Kind::kInverse}, {"disparity", Kind::kDisparity}},
+        spec.kind);
+    spec.scale = ReadYamlKey(out, "output", "scale", spec.scale);
+    spec.baseline_focal = ReadYamlKey(out, "output", "baseline_focal", spec.baseline_focal);
+    spec.canonical_focal = ReadYamlKey(out, "output", "canonical_focal", spec.canonical_focal);
+    spec.min_depth = ReadYamlKey(out, "output", "min_depth", spec.min_depth);
+    spec.max_depth = ReadYamlKey(out, "output", "max_depth", spec.max_depth);
     spec.Check();
   } catch (const std::invalid_argument& e) {
     ThrowInputError(path, e.what());

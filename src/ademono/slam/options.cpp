@@ -4,35 +4,13 @@
 #include <string>
 
 #include "ademono/core/error.h"
+#include "ademono/core/yaml_util.h"
 
 namespace ademono {
 namespace {
 
-template <typename T>
-void Read(const YAML::Node& node, const char* key, T& value) {
-  if (!node || !node[key]) return;
-  try {
-    value = node[key].as<T>();
-  } catch (const YAML::Exception&) {
-    throw std::invalid_argument(std::string("'") + key + "' has the wrong type");
-  }
-}
-
 void Require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument(message);
-}
-
-void CheckKnownKeys(const YAML::Node& node, const char* section,
-                    std::initializer_list<const char*> keys) {
-  if (!node || node.IsNull()) return;
-  if (!node.IsMap()) throw std::invalid_argument(std::string("'") + section + "' must be a map");
-  for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
-    bool known = false;
-    for (const char* k : keys) known = known || key == k;
-    if (!known)
-      throw std::invalid_argument(std::string("unknown key '") + section + "." + key + "'");
-  }
 }
 
 }  // namespace
@@ -46,16 +24,16 @@ void FrameDepthOptions::Check() const {
 }
 
 FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
-  CheckKnownKeys(node, "depth",
-                 {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor", "edge_radius",
-                  "edge_relative_jump"});
+  CheckYamlKeys(node, "depth",
+                {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor", "edge_radius",
+                 "edge_relative_jump"});
   FrameDepthOptions o;
-  Read(node, "min_depth", o.min_depth);
-  Read(node, "max_depth", o.max_depth);
-  Read(node, "virtual_baseline", o.virtual_baseline);
-  Read(node, "close_depth_factor", o.close_depth_factor);
-  Read(node, "edge_radius", o.edge_radius);
-  Read(node, "edge_relative_jump", o.edge_relative_jump);
+  o.min_depth = ReadYamlKey(node, "depth", "min_depth", o.min_depth);
+  o.max_depth = ReadYamlKey(node, "depth", "max_depth", o.max_depth);
+  o.virtual_baseline = ReadYamlKey(node, "depth", "virtual_baseline", o.virtual_baseline);
+  o.close_depth_factor = ReadYamlKey(node, "depth", "close_depth_factor", o.close_depth_factor);
+  o.edge_radius = ReadYamlKey(node, "depth", "edge_radius", o.edge_radius);
+  o.edge_relative_jump = ReadYamlKey(node, "depth", "edge_relative_jump", o.edge_relative_jump);
   o.Check();
   return o;
 }
@@ -82,7 +60,7 @@ void TrackingOptions::Check() const {
 }
 
 TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
-  CheckKnownKeys(
+  CheckYamlKeys(
       node, "tracking",
       {"min_init_points", "motion_search_radius", "min_motion_matches", "local_search_radius",
        "min_inliers", "min_inliers_after_reloc", "max_local_keyframes",
@@ -91,23 +69,34 @@ TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
        "new_keyframe_min_points", "relocalisation_keyframes", "reinit_after_lost_frames",
        "dynamic_cull_hits"});
   TrackingOptions o;
-  Read(node, "min_init_points", o.min_init_points);
-  Read(node, "motion_search_radius", o.motion_search_radius);
-  Read(node, "min_motion_matches", o.min_motion_matches);
-  Read(node, "local_search_radius", o.local_search_radius);
-  Read(node, "min_inliers", o.min_inliers);
-  Read(node, "min_inliers_after_reloc", o.min_inliers_after_reloc);
-  Read(node, "max_local_keyframes", o.max_local_keyframes);
-  Read(node, "min_frames_between_keyframes", o.min_frames_between_keyframes);
-  Read(node, "max_frames_between_keyframes", o.max_frames_between_keyframes);
-  Read(node, "keyframe_ref_ratio", o.keyframe_ref_ratio);
-  Read(node, "keyframe_ref_min_observations", o.keyframe_ref_min_observations);
-  Read(node, "close_tracked_min", o.close_tracked_min);
-  Read(node, "close_untracked_min", o.close_untracked_min);
-  Read(node, "new_keyframe_min_points", o.new_keyframe_min_points);
-  Read(node, "relocalisation_keyframes", o.relocalisation_keyframes);
-  Read(node, "reinit_after_lost_frames", o.reinit_after_lost_frames);
-  Read(node, "dynamic_cull_hits", o.dynamic_cull_hits);
+  o.min_init_points = ReadYamlKey(node, "tracking", "min_init_points", o.min_init_points);
+  o.motion_search_radius =
+      ReadYamlKey(node, "tracking", "motion_search_radius", o.motion_search_radius);
+  o.min_motion_matches = ReadYamlKey(node, "tracking", "min_motion_matches", o.min_motion_matches);
+  o.local_search_radius =
+      ReadYamlKey(node, "tracking", "local_search_radius", o.local_search_radius);
+  o.min_inliers = ReadYamlKey(node, "tracking", "min_inliers", o.min_inliers);
+  o.min_inliers_after_reloc =
+      ReadYamlKey(node, "tracking", "min_inliers_after_reloc", o.min_inliers_after_reloc);
+  o.max_local_keyframes =
+      ReadYamlKey(node, "tracking", "max_local_keyframes", o.max_local_keyframes);
+  o.min_frames_between_keyframes =
+      ReadYamlKey(node, "tracking", "min_frames_between_keyframes", o.min_frames_between_keyframes);
+  o.max_frames_between_keyframes =
+      ReadYamlKey(node, "tracking", "max_frames_between_keyframes", o.max_frames_between_keyframes);
+  o.keyframe_ref_ratio = ReadYamlKey(node, "tracking", "keyframe_ref_ratio", o.keyframe_ref_ratio);
+  o.keyframe_ref_min_observations = ReadYamlKey(node, "tracking", "keyframe_ref_min_observations",
+                                                o.keyframe_ref_min_observations);
+  o.close_tracked_min = ReadYamlKey(node, "tracking", "close_tracked_min", o.close_tracked_min);
+  o.close_untracked_min =
+      ReadYamlKey(node, "tracking", "close_untracked_min", o.close_untracked_min);
+  o.new_keyframe_min_points =
+      ReadYamlKey(node, "tracking", "new_keyframe_min_points", o.new_keyframe_min_points);
+  o.relocalisation_keyframes =
+      ReadYamlKey(node, "tracking", "relocalisation_keyframes", o.relocalisation_keyframes);
+  o.reinit_after_lost_frames =
+      ReadYamlKey(node, "tracking", "reinit_after_lost_frames", o.reinit_after_lost_frames);
+  o.dynamic_cull_hits = ReadYamlKey(node, "tracking", "dynamic_cull_hits", o.dynamic_cull_hits);
   o.Check();
   return o;
 }
@@ -123,22 +112,26 @@ void MappingOptions::Check() const {
 }
 
 MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
-  CheckKnownKeys(node, "mapping",
-                 {"deterministic", "local_ba", "cull_found_ratio", "cull_min_observations",
-                  "fuse_neighbours", "fuse_radius", "ba_max_keyframes", "redundant_ratio",
-                  "redundant_observers", "ba_first_iterations", "ba_second_iterations"});
+  CheckYamlKeys(node, "mapping",
+                {"deterministic", "local_ba", "cull_found_ratio", "cull_min_observations",
+                 "fuse_neighbours", "fuse_radius", "ba_max_keyframes", "redundant_ratio",
+                 "redundant_observers", "ba_first_iterations", "ba_second_iterations"});
   MappingOptions o;
-  Read(node, "deterministic", o.deterministic);
-  Read(node, "local_ba", o.local_ba);
-  Read(node, "cull_found_ratio", o.cull_found_ratio);
-  Read(node, "cull_min_observations", o.cull_min_observations);
-  Read(node, "fuse_neighbours", o.fuse_neighbours);
-  Read(node, "fuse_radius", o.fuse_radius);
-  Read(node, "ba_max_keyframes", o.ba_max_keyframes);
-  Read(node, "redundant_ratio", o.redundant_ratio);
-  Read(node, "redundant_observers", o.redundant_observers);
-  Read(node, "ba_first_iterations", o.ba.first_iterations);
-  Read(node, "ba_second_iterations", o.ba.second_iterations);
+  o.deterministic = ReadYamlKey(node, "mapping", "deterministic", o.deterministic);
+  o.local_ba = ReadYamlKey(node, "mapping", "local_ba", o.local_ba);
+  o.cull_found_ratio = ReadYamlKey(node, "mapping", "cull_found_ratio", o.cull_found_ratio);
+  o.cull_min_observations =
+      ReadYamlKey(node, "mapping", "cull_min_observations", o.cull_min_observations);
+  o.fuse_neighbours = ReadYamlKey(node, "mapping", "fuse_neighbours", o.fuse_neighbours);
+  o.fuse_radius = ReadYamlKey(node, "mapping", "fuse_radius", o.fuse_radius);
+  o.ba_max_keyframes = ReadYamlKey(node, "mapping", "ba_max_keyframes", o.ba_max_keyframes);
+  o.redundant_ratio = ReadYamlKey(node, "mapping", "redundant_ratio", o.redundant_ratio);
+  o.redundant_observers =
+      ReadYamlKey(node, "mapping", "redundant_observers", o.redundant_observers);
+  o.ba.first_iterations =
+      ReadYamlKey(node, "mapping", "ba_first_iterations", o.ba.first_iterations);
+  o.ba.second_iterations =
+      ReadYamlKey(node, "mapping", "ba_second_iterations", o.ba.second_iterations);
   o.Check();
   return o;
 }
@@ -156,7 +149,7 @@ SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesys
   SystemOptions o;
   try {
     if (root && !root.IsNull() && !root.IsMap()) throw std::invalid_argument("root must be a map");
-    CheckKnownKeys(
+    CheckYamlKeys(
         root, "(root)",
         {"camera", "orb", "filter", "depth", "tracking", "mapping", "optimizer", "detector"});
     if (root["orb"]) o.orb = OrbOptions::FromYaml(root["orb"]);
@@ -165,9 +158,10 @@ SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesys
     o.tracking = TrackingOptions::FromYaml(root["tracking"]);
     o.mapping = MappingOptions::FromYaml(root["mapping"]);
     const YAML::Node optimizer = root["optimizer"];
-    CheckKnownKeys(optimizer, "optimizer", {"pose_rounds", "pose_iterations_per_round"});
-    Read(optimizer, "pose_rounds", o.pose.rounds);
-    Read(optimizer, "pose_iterations_per_round", o.pose.iterations_per_round);
+    CheckYamlKeys(optimizer, "optimizer", {"pose_rounds", "pose_iterations_per_round"});
+    o.pose.rounds = ReadYamlKey(optimizer, "optimizer", "pose_rounds", o.pose.rounds);
+    o.pose.iterations_per_round = ReadYamlKey(optimizer, "optimizer", "pose_iterations_per_round",
+                                              o.pose.iterations_per_round);
     o.Check();
   } catch (const InputError&) {
     throw;
