@@ -201,6 +201,7 @@ TEST(OrbOptionsTest, FromYamlReadsKeysAndKeepsDefaults) {
 
 TEST(OrbOptionsTest, RejectsBadValues) {
   EXPECT_THROW(OrbOptions::FromYaml(YAML::Load("{num_features: many}")), std::invalid_argument);
+  EXPECT_THROW(OrbOptions::FromYaml(YAML::Load("{nfeatures: 2000}")), std::invalid_argument);
   EXPECT_THROW(OrbOptions::FromYaml(YAML::Load("{scale_factor: 1.0}")), std::invalid_argument);
   EXPECT_THROW(OrbOptions::FromYaml(YAML::Load("{num_levels: 0}")), std::invalid_argument);
   EXPECT_THROW(OrbOptions::FromYaml(YAML::Load("{min_fast_threshold: 30}")), std::invalid_argument);

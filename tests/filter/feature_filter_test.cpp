@@ -60,6 +60,12 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_inlier_px: 0}")), std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_ransac_iterations: 0}")),
                std::invalid_argument);
+  try {
+    FilterOptions::FromYaml(YAML::Load("{d_dis: 5}"));  // misspelt d_dis_px
+    ADD_FAILURE() << "unknown key accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "unknown key 'filter.d_dis'");
+  }
   FilterOptions bad;
   bad.dynamic.background_matches_t = 0;
   EXPECT_THROW(FeatureFilter{bad}, std::invalid_argument);

@@ -205,6 +205,9 @@ OrbOptions OrbOptions::FromYaml(const YAML::Node& node) {
   OrbOptions options;
   if (!node || node.IsNull()) return options;
   if (!node.IsMap()) throw std::invalid_argument("orb: expected a map of options");
+  CheckYamlKeys(node, "orb",
+                {"num_features", "scale_factor", "num_levels", "initial_fast_threshold",
+                 "min_fast_threshold"});
   options.num_features = ReadYamlKey(node, "orb", "num_features", options.num_features);
   options.scale_factor = ReadYamlKey(node, "orb", "scale_factor", options.scale_factor);
   options.num_levels = ReadYamlKey(node, "orb", "num_levels", options.num_levels);

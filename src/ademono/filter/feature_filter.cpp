@@ -84,6 +84,30 @@ FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
   FilterOptions o;
   if (!node || node.IsNull()) return o;
   if (!node.IsMap()) throw std::invalid_argument("filter: expected a map of options");
+  // A misspelt key would silently keep its default: reject it.
+  CheckYamlKeys(node, "filter",
+                {"enable_enhancement",
+                 "enable_dynamic_removal",
+                 "enable_distant_filter",
+                 "enhancement_keep_ratio",
+                 "enhancement_levels",
+                 "enhancement_p_percent",
+                 "enhancement_q_percent",
+                 "box_growth",
+                 "small_box_area_ratio",
+                 "background_matches_t",
+                 "d_dis_px",
+                 "d_min_px",
+                 "stage1_motion_compensation",
+                 "box_vote_ratio",
+                 "box_vote_min_matches",
+                 "dynamic_class_ids",
+                 "motion_min_inliers",
+                 "motion_inlier_px",
+                 "motion_ransac_iterations",
+                 "z_th_m",
+                 "drop_probability",
+                 "seed"});
   o.enable_enhancement = ReadYamlKey(node, "filter", "enable_enhancement", o.enable_enhancement);
   o.enable_dynamic_removal =
       ReadYamlKey(node, "filter", "enable_dynamic_removal", o.enable_dynamic_removal);
