@@ -54,11 +54,13 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
   }
   for (auto& p : keyframe->map_points) {
     if (!p) continue;
-    MapPoint* point = p.get();
+    // Keep the point alive while its observations are updated: the keyframe's pointer may be the
+    // last owner (a point already erased from the map), and resetting it first freed the point.
+    const std::shared_ptr<MapPoint> point = std::move(p);
     p.reset();
     point->EraseObservation(keyframe);
     if (point->observations.empty()) {
-      ErasePoint(point);
+      ErasePoint(point.get());
     } else if (!point->bad) {
       point->UpdateNormalAndDepth();
     }
