@@ -132,6 +132,8 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
   if (!prev.points_cam.empty() && prev.points_cam.size() != prev.keypoints.size())
     throw std::invalid_argument(
         "RemoveDynamicPoints: previous frame needs one camera point per keypoint (NaN if none)");
+  if (input.depths != nullptr && input.depths->size() != n)
+    throw std::invalid_argument("RemoveDynamicPoints: one depth per keypoint expected");
 
   // Match the active current points to the previous frame.
   std::vector<int> query_to_point;
@@ -161,8 +163,6 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
     cur_from_prev = FitBackgroundMotion(kps, prev, matches, in_any, *input.camera, params,
                                         &result.num_motion_inliers);
   result.motion_compensated = cur_from_prev.has_value();
-  if (input.depths != nullptr && input.depths->size() != n)
-    throw std::invalid_argument("RemoveDynamicPoints: one depth per keypoint expected");
   const std::optional<Rigid3d> prev_from_cur =
       cur_from_prev ? std::optional<Rigid3d>(cur_from_prev->inverse()) : std::nullopt;
   auto displacement = [&](size_t i, int j) -> std::optional<Eigen::Vector2d> {
