@@ -34,6 +34,7 @@ struct TrackResult {
   int num_with_depth = 0;  // kept keypoints with valid depth
   int inliers = 0;
   int dynamic_points_culled = 0;  // map points culled for sitting in dynamic boxes
+  double depth_scale = 1.0;       // network depth: this frame's scale correction
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)
