@@ -266,6 +266,15 @@ Trajectory System::FrameTrajectory() const {
   return trajectory;
 }
 
+std::vector<std::pair<size_t, double>> System::DepthScales() const {
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  std::vector<std::pair<size_t, double>> scales;
+  for (const FrameRecord& r : tracking_.Records()) {
+    if (r.tracked) scales.emplace_back(r.index, r.depth_scale);
+  }
+  return scales;
+}
+
 Trajectory System::KeyFrameTrajectory() const {
   std::lock_guard<std::mutex> lock(map_.mutex);
   Trajectory trajectory;

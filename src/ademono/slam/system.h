@@ -58,6 +58,9 @@ class System {
   // Pose of every tracked input frame, resolved against the current keyframe poses.
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
+  // Network depth: the scale correction of every tracked frame (input index, factor), against
+  // the final map (anchoring rescales update it); 1 for sensor depth.
+  std::vector<std::pair<size_t, double>> DepthScales() const;
   struct ColoredPoint {
     Eigen::Vector3d position;
     cv::Vec3b bgr;
