@@ -86,9 +86,12 @@ TEST(FeatureFilterRobustnessTest, RandomInputsGiveValidLabels) {
       ASSERT_LT(label, kNumPointLabels);
       ++count[label];
       ++total[label];
-      if (labels[i] == PointLabel::kDistantDropped)
+      if (labels[i] == PointLabel::kDistantDropped) {
         EXPECT_TRUE(std::isfinite(depths[i]) && depths[i] > 30.f);
-      if (IsDynamic(labels[i])) EXPECT_FALSE(dets.empty());
+      }
+      if (IsDynamic(labels[i])) {
+        EXPECT_FALSE(dets.empty());
+      }
     }
     // Every label is counted in the stats, and the counts add up to every keypoint.
     EXPECT_EQ(count[static_cast<int>(PointLabel::kKept)], stats.kept);
