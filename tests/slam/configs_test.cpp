@@ -10,6 +10,7 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
+#include "ademono/core/options_table.h"
 #include "ademono/slam/options.h"
 
 namespace fs = std::filesystem;
