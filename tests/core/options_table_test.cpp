@@ -33,8 +33,8 @@ struct Demo {
 };
 
 const OptionsTable<Inner>& InnerTable() {
-  static const auto table = OptionsTable<Inner>("inner").Add("count", &Inner::count,
-                                                             Range::AtLeast(1));
+  static const auto table =
+      OptionsTable<Inner>("inner").Add("count", &Inner::count, Range::AtLeast(1));
   return table;
 }
 
@@ -118,8 +118,7 @@ TEST(OptionsTable, CheckRangesNamesKeyRuleAndValue) {
   EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "demo.n must be in [0, 10], got 11");
   d = Demo{};
   d.ratio = 0;
-  EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }),
-            "demo.ratio must be in (0, 1], got 0");
+  EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "demo.ratio must be in (0, 1], got 0");
   d = Demo{};
   d.gain = 1;
   EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "demo.gain must be > 1, got 1");
@@ -132,8 +131,7 @@ TEST(OptionsTable, CheckRangesNamesKeyRuleAndValue) {
   EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "demo.ids entries must be >= 0, got -1");
   d = Demo{};
   d.inner.count = 0;
-  EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }),
-            "demo.inner_count must be >= 1, got 0");
+  EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "demo.inner_count must be >= 1, got 0");
   d = Demo{};
   d.nested.count = 0;
   EXPECT_EQ(ErrorOf([&] { DemoTable().CheckRanges(d); }), "inner.count must be >= 1, got 0");

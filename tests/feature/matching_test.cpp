@@ -48,8 +48,8 @@ TEST(RotationHistogramTest, BinsRoundToTheNearestAndWrapAt360) {
   h.Add(12.f, 0.f, 13);
   // Bins: 0 holds 12, 1 holds 3 (>= 10%), 29 holds 1 (< 10%).
   EXPECT_EQ(h.InconsistentMatches(), std::vector<int>({12}));
-  EXPECT_EQ(h.ConsistentMatches(), std::vector<int>({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12,
-                                                     12, 13}));
+  EXPECT_EQ(h.ConsistentMatches(),
+            std::vector<int>({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 12, 13}));
 }
 
 TEST(MatchBruteForceTest, RatioTestMaxDistanceAndUniqueness) {

@@ -6,9 +6,9 @@
 // keep its invariants; ASan/UBSan builds run this too.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
-#include <array>
 #include <random>
 
 #include "ademono/filter/feature_filter.h"

@@ -11,21 +11,27 @@ namespace {
 
 using testing_util::TestFeatures;
 
+// Makes `frame` (at the origin) a keyframe and every one of its keypoints a map point.
+std::shared_ptr<KeyFrame> MapEveryKeypoint(Map& map, Frame& frame) {
+  frame.cam_from_world = Rigid3d::Identity();
+  auto kf = map.CreateKeyFrame(frame);
+  for (size_t i = 0; i < frame.F().Size(); ++i) {
+    auto p = map.CreateMapPoint(frame.F().UnprojectCamera(i), kf.get(), 0);
+    p->AddObservation(kf.get(), i);
+    kf->AddMapPoint(p, i);
+    p->ComputeDistinctiveDescriptor();
+    p->UpdateNormalAndDepth();
+    frame.map_points[i] = p;
+  }
+  return kf;
+}
+
 TEST(MatcherTest, ProjectionSearchFindsTheSameDescriptorsUnderSmallMotion) {
   Map map;
   const auto f0 =
       TestFeatures({{100, 100}, {200, 150}, {400, 300}, {500, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
   Frame first(0, 0, 0.0, f0);
-  first.cam_from_world = Rigid3d::Identity();
-  auto kf = map.CreateKeyFrame(first);
-  for (size_t i = 0; i < f0->Size(); ++i) {
-    auto p = map.CreateMapPoint(f0->UnprojectCamera(i), kf.get(), 0);
-    p->AddObservation(kf.get(), i);
-    kf->AddMapPoint(p, i);
-    p->ComputeDistinctiveDescriptor();
-    p->UpdateNormalAndDepth();
-    first.map_points[i] = p;
-  }
+  const auto kf = MapEveryKeypoint(map, first);
   // The next frame sees the same points shifted by 3 px (same descriptors).
   const auto f1 =
       TestFeatures({{103, 100}, {203, 150}, {403, 300}, {503, 400}}, {1.5f, 2.0f, 2.5f, 1.8f}, 7);
@@ -58,16 +64,7 @@ TEST(MatcherTest, RotationCheckDropsTheMatchThatTurnedAgainstTheOthers) {
   }
   const auto f0 = TestFeatures(points, depths, 9, angles);
   Frame first(0, 0, 0.0, f0);
-  first.cam_from_world = Rigid3d::Identity();
-  auto kf = map.CreateKeyFrame(first);
-  for (size_t i = 0; i < f0->Size(); ++i) {
-    auto p = map.CreateMapPoint(f0->UnprojectCamera(i), kf.get(), 0);
-    p->AddObservation(kf.get(), i);
-    kf->AddMapPoint(p, i);
-    p->ComputeDistinctiveDescriptor();
-    p->UpdateNormalAndDepth();
-    first.map_points[i] = p;
-  }
+  const auto kf = MapEveryKeypoint(map, first);
   const auto f1 = TestFeatures(shifted, depths, 9, turned);
   Frame checked(1, 1, 1 / 30.0, f1), unchecked(2, 2, 1 / 30.0, f1);
   checked.cam_from_world = unchecked.cam_from_world = Rigid3d::Identity();

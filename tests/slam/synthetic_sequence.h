@@ -19,8 +19,8 @@ namespace ademono::testing_util {
 class SyntheticOffice : public Sequence {
  public:
   // `frames` at `width` x `height` (intrinsics scale with the size), camera motion `xyz`.
-  explicit SyntheticOffice(size_t frames = 80, int width = 320, int height = 240,
-                           uint64_t seed = 7, int persons = 2) {
+  explicit SyntheticOffice(size_t frames = 80, int width = 320, int height = 240, uint64_t seed = 7,
+                           int persons = 2) {
     options_.scene.scene = "office";
     options_.scene.frames = frames;
     options_.scene.seed = seed;

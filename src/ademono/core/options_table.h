@@ -122,7 +122,7 @@ class OptionsTable {
   OptionsTable&& Add(const char* key, Sub Options::*sub, T Sub::*member,
                      Range range = Range::None()) && {
     return std::move(*this).AddAt(
-        key, [sub, member](auto& o) -> auto& { return (o.*sub).*member; }, range);
+        key, [ sub, member ](auto& o) -> auto& { return (o.*sub).*member; }, range);
   }
 
   // A key whose text is one of `choices`; ToYaml writes the first name of the stored value.
@@ -158,7 +158,8 @@ class OptionsTable {
 
   // A nested section (`orb:` under the root) read by its own table into `member`.
   template <typename Sub>
-  OptionsTable&& AddSection(const char* key, Sub Options::*member, const OptionsTable<Sub>& sub) && {
+  OptionsTable&& AddSection(const char* key, Sub Options::*member,
+                            const OptionsTable<Sub>& sub) && {
     Row row;
     row.key = key;
     row.read = [member, &sub](const YAML::Node& value, const YAML::Node&, Options& o) {
@@ -339,5 +340,15 @@ class OptionsTable {
 
 // YAML text of a table's output, block style with flow lists ("key: [1, 2]").
 std::string YamlToText(const YAML::Node& node);
+
+// The usual FromYaml of an Options struct with a Table() and a Check(): defaults, then the node's
+// keys (strict), then every rule.
+template <typename Options>
+Options ReadOptions(const YAML::Node& node) {
+  Options options;
+  Options::Table().Read(node, options);
+  options.Check();
+  return options;
+}
 
 }  // namespace ademono

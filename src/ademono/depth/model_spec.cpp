@@ -26,8 +26,19 @@ bool UnitMeanStd(const YAML::Node& input) {
   return ReadYamlChoice<bool>(input, "input", "units", {{"unit", true}, {"byte", false}}, true);
 }
 
-YAML::Node Triple(const std::array<double, 3>& value) {
-  return options_internal::Encode(value);
+using Triple = std::array<double, 3> DepthModelSpec::*;
+
+OptionsTable<DepthModelSpec>::WriteFn WriteTriple(Triple member) {
+  return [member](const DepthModelSpec& s) { return options_internal::Encode(s.*member); };
+}
+
+// input.mean / input.std, stored in 0..255 units whatever `units` says.
+OptionsTable<DepthModelSpec>::ReadFn ReadMeanStd(const char* key, Triple member) {
+  return [key, member](const YAML::Node&, const YAML::Node& in, DepthModelSpec& s) {
+    const double factor = UnitMeanStd(in) ? 255.0 : 1.0;
+    s.*member = ReadTriple(in, key, s.*member);
+    for (double& v : s.*member) v *= factor;
+  };
 }
 
 int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
@@ -112,7 +123,7 @@ const OptionsTable<DepthModelSpec>& DepthModelSpec::Table() {
                 }
               },
               [](const S& s) {
-                return YAML::Node(s.pad_none                          ? "none"
+                return YAML::Node(s.pad_none                       ? "none"
                                   : s.pad == PadPlacement::kCentre ? "centre"
                                                                    : "bottom_right");
               })
@@ -121,7 +132,7 @@ const OptionsTable<DepthModelSpec>& DepthModelSpec::Table() {
               [](const YAML::Node&, const YAML::Node& in, S& s) {
                 s.pad_value = ReadTriple(in, "pad_value", s.pad_value);
               },
-              [](const S& s) { return Triple(s.pad_value); })
+              WriteTriple(&S::pad_value))
           .AddChoice<int>("interpolation", &S::interpolation,
                           {{"linear", cv::INTER_LINEAR},
                            {"cubic", cv::INTER_CUBIC},
@@ -132,22 +143,8 @@ const OptionsTable<DepthModelSpec>& DepthModelSpec::Table() {
           .AddCustom(
               "units", [](const YAML::Node&, const YAML::Node& in, S&) { UnitMeanStd(in); },
               [](const S&) { return YAML::Node("byte"); })
-          .AddCustom(
-              "mean",
-              [](const YAML::Node&, const YAML::Node& in, S& s) {
-                const double factor = UnitMeanStd(in) ? 255.0 : 1.0;
-                s.mean = ReadTriple(in, "mean", s.mean);
-                for (double& m : s.mean) m *= factor;
-              },
-              [](const S& s) { return Triple(s.mean); })
-          .AddCustom(
-              "std",
-              [](const YAML::Node&, const YAML::Node& in, S& s) {
-                const double factor = UnitMeanStd(in) ? 255.0 : 1.0;
-                s.std = ReadTriple(in, "std", s.std);
-                for (double& v : s.std) v *= factor;
-              },
-              [](const S& s) { return Triple(s.std); });
+          .AddCustom("mean", ReadMeanStd("mean", &S::mean), WriteTriple(&S::mean))
+          .AddCustom("std", ReadMeanStd("std", &S::std), WriteTriple(&S::std));
   static const auto output = OptionsTable<S>("output")
                                  .RejectEmpty()
                                  .AddChoice<Kind>("kind", &S::kind,

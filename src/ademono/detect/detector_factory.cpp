@@ -86,10 +86,7 @@ const OptionsTable<DetectorOptions>& DetectorOptions::Table() {
 void DetectorOptions::Check() const { Table().CheckRanges(*this); }
 
 DetectorOptions DetectorOptions::FromYaml(const YAML::Node& node) {
-  DetectorOptions options;
-  Table().Read(node, options);
-  options.Check();
-  return options;
+  return ReadOptions<DetectorOptions>(node);
 }
 
 YAML::Node DetectorOptions::ToYaml() const { return Table().Write(*this); }

@@ -183,13 +183,13 @@ cv::Mat ToGrey(const cv::Mat& image) {
 }  // namespace
 
 const OptionsTable<OrbOptions>& OrbOptions::Table() {
-  static const auto table = OptionsTable<OrbOptions>("orb")
-                                .Add("num_features", &OrbOptions::num_features, Range::Above(0))
-                                .Add("scale_factor", &OrbOptions::scale_factor, Range::Above(1))
-                                .Add("num_levels", &OrbOptions::num_levels, Range::Closed(1, 32))
-                                .Add("initial_fast_threshold", &OrbOptions::initial_fast_threshold,
-                                     Range::Closed(1, 254))
-                                .Add("min_fast_threshold", &OrbOptions::min_fast_threshold);
+  static const auto table =
+      OptionsTable<OrbOptions>("orb")
+          .Add("num_features", &OrbOptions::num_features, Range::Above(0))
+          .Add("scale_factor", &OrbOptions::scale_factor, Range::Above(1))
+          .Add("num_levels", &OrbOptions::num_levels, Range::Closed(1, 32))
+          .Add("initial_fast_threshold", &OrbOptions::initial_fast_threshold, Range::Closed(1, 254))
+          .Add("min_fast_threshold", &OrbOptions::min_fast_threshold);
   return table;
 }
 
@@ -201,12 +201,7 @@ void OrbOptions::Check() const {
         std::to_string(min_fast_threshold));
 }
 
-OrbOptions OrbOptions::FromYaml(const YAML::Node& node) {
-  OrbOptions options;
-  Table().Read(node, options);
-  options.Check();
-  return options;
-}
+OrbOptions OrbOptions::FromYaml(const YAML::Node& node) { return ReadOptions<OrbOptions>(node); }
 
 YAML::Node OrbOptions::ToYaml() const { return Table().Write(*this); }
 

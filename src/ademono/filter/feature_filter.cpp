@@ -87,12 +87,9 @@ void FilterOptions::Check() const {
               std::to_string(enhancement_q_percent));
 }
 
+// A misspelt key would silently keep its default: the table rejects it.
 FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
-  FilterOptions o;
-  // A misspelt key would silently keep its default: the table rejects it.
-  Table().Read(node, o);
-  o.Check();
-  return o;
+  return ReadOptions<FilterOptions>(node);
 }
 
 YAML::Node FilterOptions::ToYaml() const { return Table().Write(*this); }

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "ademono/core/error.h"
-#include "ademono/core/options_table.h"
 #include "ademono/core/file_util.h"
+#include "ademono/core/options_table.h"
 
 namespace ademono {
 namespace {
@@ -18,14 +18,13 @@ void Require(bool ok, const std::string& message) {
 
 const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
   using D = FrameDepthOptions;
-  static const auto table =
-      OptionsTable<D>("depth")
-          .Add("min_depth", &D::min_depth, Range::AtLeast(0))
-          .Add("max_depth", &D::max_depth)
-          .Add("virtual_baseline", &D::virtual_baseline, Range::Above(0))
-          .Add("close_depth_factor", &D::close_depth_factor, Range::Above(0))
-          .Add("edge_radius", &D::edge_radius, Range::Closed(0, 10))
-          .Add("edge_relative_jump", &D::edge_relative_jump, Range::Above(0));
+  static const auto table = OptionsTable<D>("depth")
+                                .Add("min_depth", &D::min_depth, Range::AtLeast(0))
+                                .Add("max_depth", &D::max_depth)
+                                .Add("virtual_baseline", &D::virtual_baseline, Range::Above(0))
+                                .Add("close_depth_factor", &D::close_depth_factor, Range::Above(0))
+                                .Add("edge_radius", &D::edge_radius, Range::Closed(0, 10))
+                                .Add("edge_relative_jump", &D::edge_relative_jump, Range::Above(0));
   return table;
 }
 
@@ -35,10 +34,7 @@ void FrameDepthOptions::Check() const {
 }
 
 FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
-  FrameDepthOptions o;
-  Table().Read(node, o);
-  o.Check();
-  return o;
+  return ReadOptions<FrameDepthOptions>(node);
 }
 
 YAML::Node FrameDepthOptions::ToYaml() const { return Table().Write(*this); }
@@ -54,8 +50,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("min_inliers", &T::min_inliers, Range::Above(0))
           .Add("min_inliers_after_reloc", &T::min_inliers_after_reloc, Range::Above(0))
           .Add("max_local_keyframes", &T::max_local_keyframes, Range::Above(0))
-          .Add("min_frames_between_keyframes", &T::min_frames_between_keyframes,
-               Range::AtLeast(0))
+          .Add("min_frames_between_keyframes", &T::min_frames_between_keyframes, Range::AtLeast(0))
           .Add("max_frames_between_keyframes", &T::max_frames_between_keyframes)
           .Add("keyframe_ref_ratio", &T::keyframe_ref_ratio, Range::OpenClosed(0, 1))
           .Add("keyframe_ref_min_observations", &T::keyframe_ref_min_observations,
@@ -76,10 +71,7 @@ void TrackingOptions::Check() const {
 }
 
 TrackingOptions TrackingOptions::FromYaml(const YAML::Node& node) {
-  TrackingOptions o;
-  Table().Read(node, o);
-  o.Check();
-  return o;
+  return ReadOptions<TrackingOptions>(node);
 }
 
 YAML::Node TrackingOptions::ToYaml() const { return Table().Write(*this); }
@@ -104,10 +96,7 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
 void MappingOptions::Check() const { Table().CheckRanges(*this); }
 
 MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
-  MappingOptions o;
-  Table().Read(node, o);
-  o.Check();
-  return o;
+  return ReadOptions<MappingOptions>(node);
 }
 
 YAML::Node MappingOptions::ToYaml() const { return Table().Write(*this); }

@@ -83,7 +83,7 @@ struct MappingOptions {
   double fuse_radius = 3;          // px at level 0
   double redundant_ratio = 0.9;    // keyframe culled when this fraction of its points ...
   int redundant_observers = 3;     // ... is seen by this many other keyframes
-  BundleAdjustmentOptions ba;  // keys ba_first_iterations, ba_second_iterations
+  BundleAdjustmentOptions ba;      // keys ba_first_iterations, ba_second_iterations
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);
   YAML::Node ToYaml() const;
