@@ -158,8 +158,8 @@ TEST(ModelSpecTest, ShippedSpecsLoad) {
 // in byte units, `pad: none` and the `center` spelling included).
 TEST(ModelSpecTest, ToYamlRoundTripsEveryShippedSpec) {
   int count = 0;
-  for (const fs::path dir : {fs::path(ADEMONO_SOURCE_DIR) / "configs" / "models",
-                             fs::path(ADEMONO_SOURCE_DIR) / "tests" / "data" / "models"}) {
+  for (const fs::path& dir : {fs::path(ADEMONO_SOURCE_DIR) / "configs" / "models",
+                              fs::path(ADEMONO_SOURCE_DIR) / "tests" / "data" / "models"}) {
     for (const auto& entry : fs::directory_iterator(dir)) {
       if (entry.path().extension() != ".yaml") continue;
       SCOPED_TRACE(entry.path().string());
