@@ -59,7 +59,7 @@ TEST(TrackingTest, TracksEveryFrameOfTheSyntheticOffice) {
   RecordProperty("ate_rmse_mm", static_cast<int>(std::lround(ate_rmse * 1000)));
   RecordProperty("worst_mm", static_cast<int>(std::lround(worst * 1000)));
   EXPECT_LT(ate_rmse, 0.02);  // 7 mm measured
-  EXPECT_LT(worst, 0.05);
+  EXPECT_LT(worst, 0.05);     // 14 mm measured
   // The persons are in view: the dynamic filter removes points on them in some frames.
   int dynamic = 0;
   for (const TrackResult& r : run.results) {
