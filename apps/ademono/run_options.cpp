@@ -113,17 +113,11 @@ YAML::Node LoadConfig(const fs::path& path) {
 }
 
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config, const fs::path& config_path) {
-  DetectorOptions options;
   try {
-    if (const YAML::Node d = config["detector"]) {
-      if (d["score_threshold"]) options.score_threshold = d["score_threshold"].as<float>();
-      if (d["nms_iou"]) options.nms_iou = d["nms_iou"].as<float>();
-    }
-    options.Check();
+    return DetectorOptions::FromYaml(config["detector"]);
   } catch (const std::exception& e) {
-    ThrowInputError(config_path, std::string("detector: ") + e.what());
+    ThrowInputError(config_path, e.what());
   }
-  return options;
 }
 
 void ParseFrames(const std::string& text, size_t size, size_t* start, size_t* end) {

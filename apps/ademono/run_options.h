@@ -48,7 +48,7 @@ std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Seq
 void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options);
 // The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
 YAML::Node LoadConfig(const std::filesystem::path& path);
-// The `detector:` node's score_threshold and nms_iou, checked.
+// The `detector:` node (DetectorOptions::FromYaml); InputError naming the file and the key.
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config,
                                           const std::filesystem::path& config_path);
 // "START:END" (either may be empty; END exclusive) within a sequence of `size` frames.

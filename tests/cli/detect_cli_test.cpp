@@ -76,7 +76,7 @@ TEST(DetectCliTest, BadInputGivesOneLineErrorAndNoOutput) {
            "unicorn",
        "unknown class 'unicorn'"},
       {"--detector model:" + (kModels / "det_yolov5.onnx").string() + ",arch=yolov5 --score 2",
-       "score threshold"},
+       "detector.score_threshold must be in [0, 1], got 2"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args);

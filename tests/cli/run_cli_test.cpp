@@ -94,12 +94,16 @@ TEST_F(RunCliTest, TwoRunsWriteIdenticalTrajectories) {
 TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
   const fs::path bad_config = out_.string() + "_bad.yaml";
   { std::ofstream(bad_config) << "tracking:\n  min_inliers: lots\n"; }
+  const fs::path bad_detector = out_.string() + "_bad_detector.yaml";
+  { std::ofstream(bad_detector) << "detector:\n  score_treshold: 0.5\n"; }
   struct Case {
     std::string args, needle;
   };
   const Case cases[] = {
       {"--frames 0:5 --config " + bad_config.string(), bad_config.string()},
       {"--frames 0:5 --config /nonexistent/config.yaml", "/nonexistent/config.yaml"},
+      {"--frames 0:5 --config " + bad_detector.string(),
+       bad_detector.string() + ": unknown key 'detector.score_treshold'"},
       {"--frames 10:5", "--frames"},
       {"--frames 0:5 --depth cache:/nonexistent/depth", "/nonexistent/depth"},
       {"--frames 0:5 --depth warp", "unknown depth provider"},
@@ -116,6 +120,7 @@ TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
   const CliResult r = RunCli("run --dataset 7scenes:/nonexistent/scene --out " + out_.string());
   EXPECT_EQ(r.code, 2) << r.out;
   fs::remove(bad_config);
+  fs::remove(bad_detector);
 }
 
 }  // namespace

@@ -154,5 +154,33 @@ TEST(ModelSpecTest, ShippedSpecsLoad) {
   EXPECT_GE(count, 4);
 }
 
+// Every shipped and test spec reads back to the same values from its ToYaml (mean/std written
+// in byte units, `pad: none` and the `center` spelling included).
+TEST(ModelSpecTest, ToYamlRoundTripsEveryShippedSpec) {
+  int count = 0;
+  for (const fs::path& dir : {fs::path(ADEMONO_SOURCE_DIR) / "configs" / "models",
+                              fs::path(ADEMONO_SOURCE_DIR) / "tests" / "data" / "models"}) {
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      if (entry.path().extension() != ".yaml") continue;
+      SCOPED_TRACE(entry.path().string());
+      const DepthModelSpec spec = DepthModelSpec::Load(entry.path());
+      const DepthModelSpec back = DepthModelSpec::FromYaml(spec.ToYaml(), "back.yaml");
+      EXPECT_TRUE(back == spec);
+      ++count;
+    }
+  }
+  EXPECT_GE(count, 9);
+  DepthModelSpec spec = Parse(
+      "input:\n  resize: multiple\n  pad: none\n  units: unit\n  mean: 0.5\n"
+      "output:\n  kind: inverse\n  scale: 0.1\n");
+  EXPECT_DOUBLE_EQ(spec.mean[1], 0.5 * 255);
+  EXPECT_TRUE(DepthModelSpec::FromYaml(spec.ToYaml(), "back.yaml") == spec);
+  spec.std[2] = 0.1 + 0.2;
+  const DepthModelSpec changed = DepthModelSpec::FromYaml(spec.ToYaml(), "back.yaml");
+  EXPECT_EQ(changed.std[2], 0.1 + 0.2);
+  EXPECT_TRUE(changed.pad_none);
+  EXPECT_EQ(changed.kind, DepthModelSpec::Kind::kInverse);
+}
+
 }  // namespace
 }  // namespace ademono

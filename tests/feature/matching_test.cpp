@@ -8,10 +8,6 @@
 namespace ademono {
 namespace {
 
-cv::KeyPoint Kp(float x, float y, int octave = 0) {
-  return cv::KeyPoint(x, y, 31.f, 0.f, 0.f, octave);
-}
-
 // A descriptor row with the first `ones` bits set.
 cv::Mat Desc(int ones) {
   cv::Mat d(1, 32, CV_8UC1, cv::Scalar(0));
@@ -41,39 +37,19 @@ TEST(RotationHistogramTest, DropsWeakSecondaryPeaks) {
   EXPECT_TRUE(RotationHistogram().InconsistentMatches().empty());
 }
 
-TEST(KeypointGridTest, WindowQueryMatchesBruteForce) {
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> ux(-5.f, 645.f), uy(-5.f, 485.f);
-  std::vector<cv::KeyPoint> kps;
-  for (int i = 0; i < 500; ++i) kps.push_back(Kp(ux(rng), uy(rng), i % 8));
-  const KeypointGrid grid(kps, cv::Size(640, 480), 10);
-  EXPECT_EQ(grid.Size(), 500u);
-  for (int q = 0; q < 50; ++q) {
-    const float u = ux(rng), v = uy(rng), r = 5.f + q;
-    const int min_level = q % 3 == 0 ? -1 : 2, max_level = q % 2 == 0 ? -1 : 5;
-    std::vector<size_t> expected;
-    for (size_t i = 0; i < kps.size(); ++i) {
-      if (std::abs(kps[i].pt.x - u) > r || std::abs(kps[i].pt.y - v) > r) continue;
-      if (min_level >= 0 && kps[i].octave < min_level) continue;
-      if (max_level >= 0 && kps[i].octave > max_level) continue;
-      expected.push_back(i);
-    }
-    EXPECT_EQ(grid.FeaturesInArea(u, v, r, min_level, max_level), expected) << "query " << q;
-  }
-}
-
-TEST(KeypointGridTest, ExactCases) {
-  const std::vector<cv::KeyPoint> kps{Kp(10, 10, 0), Kp(14, 10, 1), Kp(10, 16, 2),
-                                      Kp(-3, 479, 0)};  // last one is left of the image
-  const KeypointGrid grid(kps, cv::Size(640, 480));
-  EXPECT_EQ(grid.FeaturesInArea(10, 10, 4), std::vector<size_t>({0, 1}));
-  EXPECT_EQ(grid.FeaturesInArea(10, 10, 6), std::vector<size_t>({0, 1, 2}));
-  EXPECT_EQ(grid.FeaturesInArea(10, 10, 6, 1, 1), std::vector<size_t>({1}));
-  EXPECT_EQ(grid.FeaturesInArea(0, 480, 3), std::vector<size_t>({3}));
-  EXPECT_TRUE(grid.FeaturesInArea(300, 300, 50).empty());
-  EXPECT_EQ(grid.FeaturesInArea(10, 10, 1e30f).size(), 4u);  // huge radius: no overflow
-  EXPECT_TRUE(grid.FeaturesInArea(std::nanf(""), 10, 5).empty());
-  EXPECT_THROW(KeypointGrid(kps, cv::Size(0, 480)), std::invalid_argument);
+TEST(RotationHistogramTest, BinsRoundToTheNearestAndWrapAt360) {
+  RotationHistogram h;
+  for (int i = 0; i < 10; ++i) h.Add(0.f, 0.f, i);  // bin 0
+  h.Add(359.f, 0.f, 10);                            // 29.9 rounds to 30: wraps into bin 0
+  h.Add(5.9f, 0.f, 11);                             // 0.49: bin 0
+  h.Add(0.f, 6.1f, 12);                             // 353.9 -> 29.49: bin 29, alone
+  h.Add(12.f, 0.f, 12);                             // the same id twice is reported twice
+  h.Add(12.f, 0.f, 12);
+  h.Add(12.f, 0.f, 13);
+  // Bins: 0 holds 12, 1 holds 3 (>= 10%), 29 holds 1 (< 10%).
+  EXPECT_EQ(h.InconsistentMatches(), std::vector<int>({12}));
+  EXPECT_EQ(h.ConsistentMatches(),
+            std::vector<int>({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 12, 13}));
 }
 
 TEST(MatchBruteForceTest, RatioTestMaxDistanceAndUniqueness) {

@@ -186,3 +186,23 @@ TEST(FeatureFilterTest, RejectsInconsistentInput) {
 
 }  // namespace
 }  // namespace ademono
+
+namespace ademono {
+namespace {
+
+TEST(PointLabelTest, IsDynamicHoldsExactlyTheDynamicRemovalLabels) {
+  int dynamic = 0;
+  for (int label = 0; label < kNumPointLabels; ++label) {
+    const PointLabel l = static_cast<PointLabel>(label);
+    const std::string name = PointLabelName(l);
+    EXPECT_EQ(IsDynamic(l), name.rfind("dynamic_", 0) == 0) << name;
+    dynamic += IsDynamic(l);
+  }
+  EXPECT_EQ(dynamic, 4);
+  EXPECT_FALSE(IsDynamic(PointLabel::kKept));
+  EXPECT_FALSE(IsDynamic(PointLabel::kDistantDropped));
+  EXPECT_TRUE(IsDynamic(PointLabel::kDynamicBoxVote));
+}
+
+}  // namespace
+}  // namespace ademono

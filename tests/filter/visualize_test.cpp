@@ -12,11 +12,14 @@ cv::Vec3b Bgr(const cv::Scalar& s) {
 
 TEST(DrawFilterResultTest, ColoursPointsByLabelAndDrawsBoxes) {
   const cv::Mat grey(480, 640, CV_8UC1, cv::Scalar(0));
-  const std::vector<cv::KeyPoint> kps{{400, 300, 31}, {450, 300, 31}, {500, 300, 31},
-                                      {400, 400, 31}, {450, 400, 31}, {500, 400, 31}};
-  const std::vector<PointLabel> labels{
-      PointLabel::kKept,          PointLabel::kEnhancementDropped, PointLabel::kDynamicSmallBox,
-      PointLabel::kDynamicStage1, PointLabel::kDynamicStage2,      PointLabel::kDistantDropped};
+  // One point per label, in a row 50 px apart.
+  std::vector<cv::KeyPoint> kps;
+  std::vector<PointLabel> labels;
+  for (int label = 0; label < kNumPointLabels; ++label) {
+    kps.emplace_back(400.f + 50.f * static_cast<float>(label % 4), 300.f + 100.f * (label / 4),
+                     31.f);
+    labels.push_back(static_cast<PointLabel>(label));
+  }
   Detection car;
   car.class_id = 2;
   car.class_name = "car";
@@ -33,11 +36,17 @@ TEST(DrawFilterResultTest, ColoursPointsByLabelAndDrawsBoxes) {
   // Thick border of the grown box (d = 0.02 * 250 = 5): left edge at x = 295.
   EXPECT_NE(At(out, 295, 200), cv::Vec3b(0, 0, 0));
   EXPECT_EQ(At(out, 320, 200), cv::Vec3b(0, 0, 0));
-  // Distinct colours for every label.
-  for (int a = 0; a < 6; ++a)
-    for (int b = a + 1; b < 6; ++b)
+  // Distinct colours and names for every label.
+  for (int a = 0; a < kNumPointLabels; ++a)
+    for (int b = a + 1; b < kNumPointLabels; ++b)
       EXPECT_NE(Bgr(PointLabelColor(static_cast<PointLabel>(a))),
                 Bgr(PointLabelColor(static_cast<PointLabel>(b))));
+  for (int a = 0; a < kNumPointLabels; ++a)
+    for (int b = a + 1; b < kNumPointLabels; ++b)
+      EXPECT_STRNE(PointLabelName(static_cast<PointLabel>(a)),
+                   PointLabelName(static_cast<PointLabel>(b)));
+  for (int a = 0; a < kNumPointLabels; ++a)
+    EXPECT_STRNE(PointLabelName(static_cast<PointLabel>(a)), "unknown");
   EXPECT_THROW(DrawFilterResult(grey, kps, {PointLabel::kKept}, {}, FilterOptions{}),
                std::invalid_argument);
   EXPECT_THROW(DrawFilterResult(cv::Mat(), {}, {}, {}, FilterOptions{}), std::invalid_argument);

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "ademono/core/error.h"
-#include "ademono/core/yaml_util.h"
+#include "ademono/core/options_table.h"
 
 namespace ademono {
 namespace {
@@ -21,12 +21,24 @@ std::array<double, 3> ReadTriple(const YAML::Node& node, const char* key,
   return ReadYamlKey(node, "input", key, value, kExpected);
 }
 
-// Spec sections are maps when present; unlike the SLAM config, an empty `input:` is an error.
-void CheckSectionKeys(const YAML::Node& node, const char* section,
-                      std::initializer_list<std::string_view> keys) {
-  if (node && node.IsNull())
-    throw std::invalid_argument(std::string("'") + section + "' is empty, expected a map");
-  CheckYamlKeys(node, section, keys);
+// input.units: mean/std in 0..1 (unit, the default) or 0..255 (byte) units.
+bool UnitMeanStd(const YAML::Node& input) {
+  return ReadYamlChoice<bool>(input, "input", "units", {{"unit", true}, {"byte", false}}, true);
+}
+
+using Triple = std::array<double, 3> DepthModelSpec::*;
+
+OptionsTable<DepthModelSpec>::WriteFn WriteTriple(Triple member) {
+  return [member](const DepthModelSpec& s) { return options_internal::Encode(s.*member); };
+}
+
+// input.mean / input.std, stored in 0..255 units whatever `units` says.
+OptionsTable<DepthModelSpec>::ReadFn ReadMeanStd(const char* key, Triple member) {
+  return [key, member](const YAML::Node&, const YAML::Node& in, DepthModelSpec& s) {
+    const double factor = UnitMeanStd(in) ? 255.0 : 1.0;
+    s.*member = ReadTriple(in, key, s.*member);
+    for (double& v : s.*member) v *= factor;
+  };
 }
 
 int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
@@ -59,6 +71,10 @@ std::string ToString(DepthModelSpec::Resize resize) {
 
 void DepthModelSpec::Check() const {
   auto fail = [](const std::string& message) { throw std::invalid_argument(message); };
+  Table().CheckRanges(*this);
+  if (!domain.empty() && domain != "indoor" && domain != "outdoor") {
+    fail("domain must be indoor or outdoor, got '" + domain + "'");
+  }
   if (resize != Resize::kMultiple) {
     if (width < 0 || height < 0 || (width == 0) != (height == 0)) {
       fail("input.width and input.height must both be positive (or both 0 = model size)");
@@ -66,7 +82,6 @@ void DepthModelSpec::Check() const {
   } else {
     if (side_length < 0) fail("input.side_length must be >= 0");
   }
-  if (multiple_of < 1) fail("input.multiple_of must be >= 1");
   if (pad_none && resize != Resize::kMultiple) fail("input.pad: none needs resize: multiple");
   for (int c = 0; c < 3; ++c) {
     if (!(std[c] > 0)) fail("input.std must be positive");
@@ -75,7 +90,6 @@ void DepthModelSpec::Check() const {
     fail("output.baseline_focal must be positive for kind disparity");
   }
   if (kind != Kind::kDisparity && !(scale > 0)) fail("output.scale must be positive");
-  if (canonical_focal < 0) fail("output.canonical_focal must be >= 0");
   if (canonical_focal > 0 && kind != Kind::kMetric) {
     fail("output.canonical_focal applies to kind metric only");
   }
@@ -84,85 +98,93 @@ void DepthModelSpec::Check() const {
   }
 }
 
+const OptionsTable<DepthModelSpec>& DepthModelSpec::Table() {
+  using S = DepthModelSpec;
+  // Spec sections are maps when present; unlike the SLAM config, an empty `input:` is an error.
+  static const auto input =
+      OptionsTable<S>("input")
+          .RejectEmpty()
+          .AddChoice<Resize>("resize", &S::resize,
+                             {{"fixed", Resize::kFixed},
+                              {"letterbox", Resize::kLetterbox},
+                              {"multiple", Resize::kMultiple}})
+          .Add("width", &S::width)
+          .Add("height", &S::height)
+          .AddChoice<bool>("side", &S::long_side, {{"long", true}, {"short", false}})
+          .Add("side_length", &S::side_length)
+          .Add("multiple_of", &S::multiple_of, Range::AtLeast(1))
+          .AddCustom(
+              "pad",
+              [](const YAML::Node&, const YAML::Node& in, S& s) {
+                s.pad_none = ReadYamlKey(in, "input", "pad", std::string()) == "none";
+                if (!s.pad_none) {
+                  s.pad = ReadYamlChoice<PadPlacement>(in, "input", "pad",
+                                                       {{"centre", PadPlacement::kCentre},
+                                                        {"center", PadPlacement::kCentre},
+                                                        {"bottom_right", PadPlacement::kTopLeft}},
+                                                       s.pad);
+                }
+              },
+              [](const S& s) {
+                return YAML::Node(s.pad_none                       ? "none"
+                                  : s.pad == PadPlacement::kCentre ? "centre"
+                                                                   : "bottom_right");
+              })
+          .AddCustom(
+              "pad_value",
+              [](const YAML::Node&, const YAML::Node& in, S& s) {
+                s.pad_value = ReadTriple(in, "pad_value", s.pad_value);
+              },
+              WriteTriple(&S::pad_value))
+          .AddChoice<int>("interpolation", &S::interpolation,
+                          {{"linear", cv::INTER_LINEAR},
+                           {"cubic", cv::INTER_CUBIC},
+                           {"area", cv::INTER_AREA},
+                           {"nearest", cv::INTER_NEAREST}})
+          .AddChoice<bool>("color", &S::rgb, {{"rgb", true}, {"bgr", false}})
+          // Stored in 0..255 units: `units` only says how mean/std are written.
+          .AddCustom(
+              "units", [](const YAML::Node&, const YAML::Node& in, S&) { UnitMeanStd(in); },
+              [](const S&) { return YAML::Node("byte"); })
+          .AddCustom("mean", ReadMeanStd("mean", &S::mean), WriteTriple(&S::mean))
+          .AddCustom("std", ReadMeanStd("std", &S::std), WriteTriple(&S::std));
+  static const auto output = OptionsTable<S>("output")
+                                 .RejectEmpty()
+                                 .AddChoice<Kind>("kind", &S::kind,
+                                                  {{"metric", Kind::kMetric},
+                                                   {"inverse", Kind::kInverse},
+                                                   {"disparity", Kind::kDisparity}})
+                                 .Add("scale", &S::scale)
+                                 .Add("baseline_focal", &S::baseline_focal)
+                                 .Add("canonical_focal", &S::canonical_focal, Range::AtLeast(0))
+                                 .Add("min_depth", &S::min_depth)
+                                 .Add("max_depth", &S::max_depth);
+  static const auto uncertainty =
+      OptionsTable<DepthErrorModel>("uncertainty")
+          .Add("relative", &DepthErrorModel::relative, Range::AtLeast(0))
+          .Add("per_metre", &DepthErrorModel::per_metre, Range::AtLeast(0));
+  static const auto table = OptionsTable<S>("spec")
+                                .Add("name", &S::name)
+                                .Add("domain", &S::domain)
+                                .AddSection("uncertainty", &S::uncertainty, uncertainty)
+                                .AddSection("input", input)
+                                .AddSection("output", output);
+  return table;
+}
+
 DepthModelSpec DepthModelSpec::FromYaml(const YAML::Node& node, const std::filesystem::path& path) {
   DepthModelSpec spec;
   if (!node || !node.IsMap()) ThrowInputError(path, "model spec must be a YAML mapping");
   try {
-    CheckYamlKeys(node, "spec", {"name", "input", "output", "domain", "uncertainty"});
-    spec.name = ReadYamlKey(node, "spec", "name", spec.name);
-    spec.domain = ReadYamlChoice<std::string>(
-        node, "spec", "domain", {{"indoor", "indoor"}, {"outdoor", "outdoor"}}, "");
-    const YAML::Node uncertainty = node["uncertainty"];
-    CheckSectionKeys(uncertainty, "uncertainty", {"relative", "per_metre"});
-    spec.uncertainty.relative = ReadYamlKey(uncertainty, "uncertainty", "relative", 0.0);
-    spec.uncertainty.per_metre = ReadYamlKey(uncertainty, "uncertainty", "per_metre", 0.0);
-    if (spec.uncertainty.relative < 0 || spec.uncertainty.per_metre < 0) {
-      throw std::invalid_argument("uncertainty: relative and per_metre must be >= 0");
-    }
-    const YAML::Node in = node["input"];
-    CheckSectionKeys(in, "input",
-                     {"resize", "width", "height", "side", "side_length", "multiple_of", "pad",
-                      "pad_value", "interpolation", "color", "units", "mean", "std"});
-    spec.resize = ReadYamlChoice<Resize>(in, "input", "resize",
-                                         {{"fixed", Resize::kFixed},
-                                          {"letterbox", Resize::kLetterbox},
-                                          {"multiple", Resize::kMultiple}},
-                                         spec.resize);
-    spec.width = ReadYamlKey(in, "input", "width", spec.width);
-    spec.height = ReadYamlKey(in, "input", "height", spec.height);
-    spec.long_side =
-        ReadYamlChoice<bool>(in, "input", "side", {{"long", true}, {"short", false}}, true);
-    spec.side_length = ReadYamlKey(in, "input", "side_length", spec.side_length);
-    spec.multiple_of = ReadYamlKey(in, "input", "multiple_of", spec.multiple_of);
-    spec.pad_none = ReadYamlKey(in, "input", "pad", std::string()) == "none";
-    if (!spec.pad_none) {
-      spec.pad = ReadYamlChoice<PadPlacement>(in, "input", "pad",
-                                              {{"centre", PadPlacement::kCentre},
-                                               {"center", PadPlacement::kCentre},
-                                               {"bottom_right", PadPlacement::kTopLeft}},
-                                              spec.pad);
-    }
-    spec.pad_value = ReadTriple(in, "pad_value", spec.pad_value);
-    spec.interpolation = ReadYamlChoice<int>(in, "input", "interpolation",
-                                             {{"linear", cv::INTER_LINEAR},
-                                              {"cubic", cv::INTER_CUBIC},
-                                              {"area", cv::INTER_AREA},
-                                              {"nearest", cv::INTER_NEAREST}},
-                                             spec.interpolation);
-    spec.rgb = ReadYamlChoice<bool>(in, "input", "color", {{"rgb", true}, {"bgr", false}}, true);
-    const bool unit = ReadYamlChoice<bool>(in, "input", "units", {{"unit", true}, {"byte", false}},
-                                           /*default: mean/std in 0..1*/ true);
-    const double factor = unit ? 255.0 : 1.0;
-    std::array<double, 3> mean{0.485, 0.456, 0.406}, std{0.229, 0.224, 0.225};
-    if (!unit) {
-      for (int c = 0; c < 3; ++c) mean[c] *= 255, std[c] *= 255;
-    }
-    mean = ReadTriple(in, "mean", mean);
-    std = ReadTriple(in, "std", std);
-    for (int c = 0; c < 3; ++c) {
-      spec.mean[c] = mean[c] * factor;
-      spec.std[c] = std[c] * factor;
-    }
-
-    const YAML::Node out = node["output"];
-    CheckSectionKeys(
-        out, "output",
-        {"kind", "scale", "baseline_focal", "canonical_focal", "min_depth", "max_depth"});
-    spec.kind = ReadYamlChoice<Kind>(
-        out, "output", "kind",
-        {{"metric", Kind::kMetric}, {"inverse", Kind::kInverse}, {"disparity", Kind::kDisparity}},
-        spec.kind);
-    spec.scale = ReadYamlKey(out, "output", "scale", spec.scale);
-    spec.baseline_focal = ReadYamlKey(out, "output", "baseline_focal", spec.baseline_focal);
-    spec.canonical_focal = ReadYamlKey(out, "output", "canonical_focal", spec.canonical_focal);
-    spec.min_depth = ReadYamlKey(out, "output", "min_depth", spec.min_depth);
-    spec.max_depth = ReadYamlKey(out, "output", "max_depth", spec.max_depth);
+    Table().Read(node, spec);
     spec.Check();
   } catch (const std::invalid_argument& e) {
     ThrowInputError(path, e.what());
   }
   return spec;
 }
+
+YAML::Node DepthModelSpec::ToYaml() const { return Table().Write(*this); }
 
 DepthModelSpec DepthModelSpec::Load(const std::filesystem::path& path) {
   RequireFile(path);

@@ -57,6 +57,9 @@
 
 namespace ademono {
 
+template <typename Options>
+class OptionsTable;
+
 struct DepthModelSpec {
   enum class Resize { kFixed, kLetterbox, kMultiple };
   enum class Kind { kMetric, kInverse, kDisparity };
@@ -93,6 +96,10 @@ struct DepthModelSpec {
   // and the key for a bad value or an unknown key.
   static DepthModelSpec FromYaml(const YAML::Node& node, const std::filesystem::path& path);
   static DepthModelSpec Load(const std::filesystem::path& path);
+  // Every key (mean/std written with `units: byte`): FromYaml(ToYaml()) == *this.
+  YAML::Node ToYaml() const;
+  static const OptionsTable<DepthModelSpec>& Table();  // core/options_table.h
+  bool operator==(const DepthModelSpec&) const = default;
 
   // Network input size for an image of `image_size`, and the size the image is scaled to
   // inside it (the rest is padding).

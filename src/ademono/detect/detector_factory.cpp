@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "ademono/core/error.h"
+#include "ademono/core/options_table.h"
 #include "ademono/detect/detection_io.h"
 #include "ademono/detect/yolo_detector.h"
 #include "ademono/dnn/model_arg.h"
@@ -70,24 +71,25 @@ class CacheDetector : public Detector {
 
 }  // namespace
 
-void DetectorOptions::Check() const {
-  if (!(score_threshold >= 0.f && score_threshold <= 1.f)) {
-    throw std::invalid_argument("detector score threshold must be in [0, 1], got " +
-                                std::to_string(score_threshold));
-  }
-  if (!(nms_iou > 0.f && nms_iou <= 1.f)) {
-    throw std::invalid_argument("detector NMS IoU must be in (0, 1], got " +
-                                std::to_string(nms_iou));
-  }
-  for (int id : class_ids) {
-    if (id < 0)
-      throw std::invalid_argument("detector class ids must be >= 0, got " + std::to_string(id));
-  }
-  if (num_threads < 1 || num_threads > 64) {
-    throw std::invalid_argument("detector threads must be in [1, 64], got " +
-                                std::to_string(num_threads));
-  }
+const OptionsTable<DetectorOptions>& DetectorOptions::Table() {
+  using D = DetectorOptions;
+  static const auto table =
+      OptionsTable<D>("detector")
+          .Add("score_threshold", &D::score_threshold, Range::Closed(0, 1))
+          .Add("nms_iou", &D::nms_iou, Range::OpenClosed(0, 1))
+          .Add("class_ids", &D::class_ids, Range::AtLeast(0))  // [] = all 80 COCO classes
+          .Add("class_agnostic_nms", &D::class_agnostic_nms)
+          .Add("num_threads", &D::num_threads, Range::Closed(1, 64));
+  return table;
 }
+
+void DetectorOptions::Check() const { Table().CheckRanges(*this); }
+
+DetectorOptions DetectorOptions::FromYaml(const YAML::Node& node) {
+  return ReadOptions<DetectorOptions>(node);
+}
+
+YAML::Node DetectorOptions::ToYaml() const { return Table().Write(*this); }
 
 std::vector<int> ParseClassList(const std::string& text) {
   if (text == "all") return {};

@@ -92,8 +92,11 @@ void RotationHistogram::Add(float angle_from_deg, float angle_to_deg, int match_
   rotation = std::fmod(rotation, 360.f);
   if (rotation < 0.f) rotation += 360.f;
   const int num_bins = NumBins();
-  int bin = static_cast<int>(std::lround(rotation * num_bins / 360.f));
+  // rotation * (bins / 360), rounded, in float: the arithmetic the tracker's results rest on.
+  const float factor = static_cast<float>(num_bins) / 360.f;
+  int bin = static_cast<int>(std::round(rotation * factor));
   if (bin == num_bins) bin = 0;
+  bin = std::clamp(bin, 0, num_bins - 1);
   bins_[bin].push_back(match_index);
 }
 
@@ -140,56 +143,6 @@ std::vector<int> RotationHistogram::ConsistentMatches() const {
   std::vector<int> out;
   for (int b = 0; b < NumBins(); ++b)
     if (dominant[b]) out.insert(out.end(), bins_[b].begin(), bins_[b].end());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-KeypointGrid::KeypointGrid(const std::vector<cv::KeyPoint>& keypoints, cv::Size image_size,
-                           int cell_size_px)
-    : image_size_(image_size), cell_size_(cell_size_px) {
-  if (image_size.width <= 0 || image_size.height <= 0)
-    throw std::invalid_argument("KeypointGrid: image size must be positive");
-  if (cell_size_px < 1) throw std::invalid_argument("KeypointGrid: cell size must be >= 1");
-  cols_ = (image_size.width + cell_size_ - 1) / cell_size_;
-  rows_ = (image_size.height + cell_size_ - 1) / cell_size_;
-  cells_.resize(static_cast<size_t>(cols_) * rows_);
-  points_.reserve(keypoints.size());
-  octaves_.reserve(keypoints.size());
-  for (size_t i = 0; i < keypoints.size(); ++i) {
-    points_.push_back(keypoints[i].pt);
-    octaves_.push_back(keypoints[i].octave);
-    cells_[static_cast<size_t>(CellY(keypoints[i].pt.y)) * cols_ + CellX(keypoints[i].pt.x)]
-        .push_back(i);
-  }
-}
-
-int KeypointGrid::CellX(float u) const {
-  const float c = u / static_cast<float>(cell_size_);
-  if (!(c >= 0.f)) return 0;  // also NaN
-  return c >= static_cast<float>(cols_ - 1) ? cols_ - 1 : static_cast<int>(c);
-}
-
-int KeypointGrid::CellY(float v) const {
-  const float c = v / static_cast<float>(cell_size_);
-  if (!(c >= 0.f)) return 0;
-  return c >= static_cast<float>(rows_ - 1) ? rows_ - 1 : static_cast<int>(c);
-}
-
-std::vector<size_t> KeypointGrid::FeaturesInArea(float u, float v, float r, int min_level,
-                                                 int max_level) const {
-  std::vector<size_t> out;
-  if (!(r >= 0.f) || !std::isfinite(u) || !std::isfinite(v)) return out;
-  const int cx0 = CellX(u - r), cx1 = CellX(u + r);
-  const int cy0 = CellY(v - r), cy1 = CellY(v + r);
-  for (int cy = cy0; cy <= cy1; ++cy) {
-    for (int cx = cx0; cx <= cx1; ++cx) {
-      for (size_t i : cells_[static_cast<size_t>(cy) * cols_ + cx]) {
-        if (min_level >= 0 && octaves_[i] < min_level) continue;
-        if (max_level >= 0 && octaves_[i] > max_level) continue;
-        if (std::abs(points_[i].x - u) <= r && std::abs(points_[i].y - v) <= r) out.push_back(i);
-      }
-    }
-  }
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Generic ORB matching helpers (after ORB-SLAM's matcher): Hamming distance (DescriptorDistance,
-// declared in orb_extractor.h), a rotation-consistency histogram, a keypoint grid for window
-// search, and brute-force matching with a ratio test.
+// declared in orb_extractor.h), the Hamming thresholds and rotation-consistency histogram that
+// slam/matcher uses, and brute-force matching with a ratio test (the dynamic filter's stage 1).
+// Window search over keypoints is FrameFeatures::FeaturesInArea (slam/frame.h).
 //
 // Contract: descriptors are CV_8UC1 with 32 columns, one row per keypoint (OrbExtractor's output).
 // Every function is deterministic: ties are broken towards the lowest index.
@@ -36,30 +37,6 @@ class RotationHistogram {
  private:
   std::vector<bool> DominantBins() const;
   std::vector<std::vector<int>> bins_;
-};
-
-// Keypoints bucketed into a grid of square cells for window queries (ORB-SLAM's
-// GetFeaturesInArea). Keypoints outside the image are clamped into the border cells, so every
-// keypoint can be found.
-class KeypointGrid {
- public:
-  KeypointGrid(const std::vector<cv::KeyPoint>& keypoints, cv::Size image_size,
-               int cell_size_px = 10);
-  // Indices (ascending) of keypoints with |u' - u| <= r and |v' - v| <= r (a square window, as
-  // ORB-SLAM) whose octave lies in [min_level, max_level]; a negative bound means unbounded.
-  std::vector<size_t> FeaturesInArea(float u, float v, float r, int min_level = -1,
-                                     int max_level = -1) const;
-  size_t Size() const { return points_.size(); }
-
- private:
-  int CellX(float u) const;
-  int CellY(float v) const;
-  cv::Size image_size_;
-  int cell_size_;
-  int cols_, rows_;
-  std::vector<cv::Point2f> points_;
-  std::vector<int> octaves_;
-  std::vector<std::vector<size_t>> cells_;  // row-major, rows_ x cols_
 };
 
 struct BruteForceMatchOptions {

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "ademono/core/yaml_util.h"
+#include "ademono/core/options_table.h"
 
 namespace ademono {
 namespace {
@@ -182,42 +182,28 @@ cv::Mat ToGrey(const cv::Mat& image) {
 
 }  // namespace
 
+const OptionsTable<OrbOptions>& OrbOptions::Table() {
+  static const auto table =
+      OptionsTable<OrbOptions>("orb")
+          .Add("num_features", &OrbOptions::num_features, Range::Above(0))
+          .Add("scale_factor", &OrbOptions::scale_factor, Range::Above(1))
+          .Add("num_levels", &OrbOptions::num_levels, Range::Closed(1, 32))
+          .Add("initial_fast_threshold", &OrbOptions::initial_fast_threshold, Range::Closed(1, 254))
+          .Add("min_fast_threshold", &OrbOptions::min_fast_threshold);
+  return table;
+}
+
 void OrbOptions::Check() const {
-  if (num_features <= 0)
-    throw std::invalid_argument("orb.num_features must be > 0, got " +
-                                std::to_string(num_features));
-  if (!(scale_factor > 1.f) || !std::isfinite(scale_factor))
-    throw std::invalid_argument("orb.scale_factor must be > 1, got " +
-                                std::to_string(scale_factor));
-  if (num_levels < 1 || num_levels > 32)
-    throw std::invalid_argument("orb.num_levels must be in [1, 32], got " +
-                                std::to_string(num_levels));
-  if (initial_fast_threshold < 1 || initial_fast_threshold > 254)
-    throw std::invalid_argument("orb.initial_fast_threshold must be in [1, 254], got " +
-                                std::to_string(initial_fast_threshold));
+  Table().CheckRanges(*this);
   if (min_fast_threshold < 1 || min_fast_threshold > initial_fast_threshold)
     throw std::invalid_argument(
         "orb.min_fast_threshold must be in [1, initial_fast_threshold], got " +
         std::to_string(min_fast_threshold));
 }
 
-OrbOptions OrbOptions::FromYaml(const YAML::Node& node) {
-  OrbOptions options;
-  if (!node || node.IsNull()) return options;
-  if (!node.IsMap()) throw std::invalid_argument("orb: expected a map of options");
-  CheckYamlKeys(node, "orb",
-                {"num_features", "scale_factor", "num_levels", "initial_fast_threshold",
-                 "min_fast_threshold"});
-  options.num_features = ReadYamlKey(node, "orb", "num_features", options.num_features);
-  options.scale_factor = ReadYamlKey(node, "orb", "scale_factor", options.scale_factor);
-  options.num_levels = ReadYamlKey(node, "orb", "num_levels", options.num_levels);
-  options.initial_fast_threshold =
-      ReadYamlKey(node, "orb", "initial_fast_threshold", options.initial_fast_threshold);
-  options.min_fast_threshold =
-      ReadYamlKey(node, "orb", "min_fast_threshold", options.min_fast_threshold);
-  options.Check();
-  return options;
-}
+OrbOptions OrbOptions::FromYaml(const YAML::Node& node) { return ReadOptions<OrbOptions>(node); }
+
+YAML::Node OrbOptions::ToYaml() const { return Table().Write(*this); }
 
 OrbExtractor::OrbExtractor(const OrbOptions& options) : options_(options) {
   options_.Check();

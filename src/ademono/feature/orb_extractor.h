@@ -14,6 +14,9 @@
 
 namespace ademono {
 
+template <typename Options>
+class OptionsTable;
+
 struct OrbOptions {
   int num_features = 1000;
   float scale_factor = 1.2f;
@@ -23,6 +26,9 @@ struct OrbOptions {
   void Check() const;  // throws std::invalid_argument
   // Reads the `orb:` sub-node; absent keys keep their defaults.
   static OrbOptions FromYaml(const YAML::Node& node);
+  YAML::Node ToYaml() const;
+  static const OptionsTable<OrbOptions>& Table();  // the keys of `orb:` (core/options_table.h)
+  bool operator==(const OrbOptions&) const = default;
 };
 
 class OrbExtractor {

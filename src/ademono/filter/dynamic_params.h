@@ -8,6 +8,9 @@
 
 namespace ademono {
 
+template <typename Options>
+class OptionsTable;
+
 struct DynamicParams {
   double box_growth = 0.02;            // d = box_growth * box diagonal on every side
   double small_box_area_ratio = 0.05;  // box area / image area below this: drop all inside
@@ -31,6 +34,9 @@ struct DynamicParams {
   int match_max_distance = 100;
 
   void Check() const;  // throws std::invalid_argument("filter.<key> ...")
+  // Its keys of the flat `filter:` node (FilterOptions::Table() holds them in place).
+  static const OptionsTable<DynamicParams>& Table();
+  bool operator==(const DynamicParams&) const = default;
 };
 
 }  // namespace ademono

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "ademono/core/yaml_util.h"
+#include "ademono/core/options_table.h"
 #include "ademono/filter/distant.h"
 #include "ademono/filter/dynamic.h"
 #include "ademono/filter/enhancement.h"
@@ -38,115 +38,61 @@ const char* PointLabelName(PointLabel label) {
   return "unknown";
 }
 
-void DynamicParams::Check() const {
-  Require(box_growth >= 0 && box_growth <= 1,
-          "box_growth must be in [0, 1], got " + std::to_string(box_growth));
-  Require(small_box_area_ratio >= 0 && small_box_area_ratio <= 1,
-          "small_box_area_ratio must be in [0, 1], got " + std::to_string(small_box_area_ratio));
-  Require(background_matches_t >= 1,
-          "background_matches_t must be >= 1, got " + std::to_string(background_matches_t));
-  Require(d_dis_px > 0 && std::isfinite(d_dis_px),
-          "d_dis_px must be > 0, got " + std::to_string(d_dis_px));
-  Require(d_min_px > 0 && std::isfinite(d_min_px),
-          "d_min_px must be > 0, got " + std::to_string(d_min_px));
-  Require(
-      box_vote_ratio >= 0 && std::isfinite(box_vote_ratio),
-      "box_vote_ratio must be >= 0 (> 1 disables the vote), got " + std::to_string(box_vote_ratio));
-  Require(box_vote_min_matches >= 1,
-          "box_vote_min_matches must be >= 1, got " + std::to_string(box_vote_min_matches));
-  Require(motion_min_inliers >= 4,
-          "motion_min_inliers must be >= 4, got " + std::to_string(motion_min_inliers));
-  Require(motion_inlier_px > 0 && std::isfinite(motion_inlier_px),
-          "motion_inlier_px must be > 0, got " + std::to_string(motion_inlier_px));
-  Require(motion_ransac_iterations >= 1,
-          "motion_ransac_iterations must be >= 1, got " + std::to_string(motion_ransac_iterations));
+const OptionsTable<DynamicParams>& DynamicParams::Table() {
+  using P = DynamicParams;
+  static const auto table =
+      OptionsTable<P>("filter")
+          .Add("box_growth", &P::box_growth, Range::Closed(0, 1))
+          .Add("small_box_area_ratio", &P::small_box_area_ratio, Range::Closed(0, 1))
+          .Add("background_matches_t", &P::background_matches_t, Range::AtLeast(1))
+          .Add("d_dis_px", &P::d_dis_px, Range::Above(0))
+          .Add("d_min_px", &P::d_min_px, Range::Above(0))
+          .Add("stage1_motion_compensation", &P::stage1_motion_compensation)
+          .Add("box_vote_ratio", &P::box_vote_ratio, Range::AtLeast(0))  // > 1 disables the vote
+          .Add("box_vote_min_matches", &P::box_vote_min_matches, Range::AtLeast(1))
+          .Add("dynamic_class_ids", &P::dynamic_class_ids)
+          .Add("motion_min_inliers", &P::motion_min_inliers, Range::AtLeast(4))
+          .Add("motion_inlier_px", &P::motion_inlier_px, Range::Above(0))
+          .Add("motion_ransac_iterations", &P::motion_ransac_iterations, Range::AtLeast(1));
+  return table;
+}
+
+void DynamicParams::Check() const { Table().CheckRanges(*this); }
+
+const OptionsTable<FilterOptions>& FilterOptions::Table() {
+  using F = FilterOptions;
+  static const auto table =
+      OptionsTable<F>("filter")
+          .Add("enable_enhancement", &F::enable_enhancement)
+          .Add("enable_dynamic_removal", &F::enable_dynamic_removal)
+          .Add("enable_distant_filter", &F::enable_distant_filter)
+          .Add("enhancement_keep_ratio", &F::enhancement_keep_ratio, Range::OpenClosed(0, 1))
+          .Add("enhancement_levels", &F::enhancement_levels, Range::Closed(0, 6))
+          .Add("enhancement_p_percent", &F::enhancement_p_percent)
+          .Add("enhancement_q_percent", &F::enhancement_q_percent)
+          .AddFlat(&F::dynamic, DynamicParams::Table())
+          .Add("z_th_m", &F::z_th_m, Range::Above(0))
+          .Add("drop_probability", &F::drop_probability, Range::Closed(0, 1))
+          .Add("seed", &F::seed);
+  return table;
 }
 
 void FilterOptions::Check() const {
-  Require(
-      enhancement_keep_ratio > 0 && enhancement_keep_ratio <= 1,
-      "enhancement_keep_ratio must be in (0, 1], got " + std::to_string(enhancement_keep_ratio));
-  Require(enhancement_levels >= 0 && enhancement_levels <= 6,
-          "enhancement_levels must be in [0, 6], got " + std::to_string(enhancement_levels));
+  Table().CheckRanges(*this);
   Require(std::isfinite(enhancement_p_percent) && enhancement_p_percent != 0,
           "enhancement_p_percent must be > 0 (or < 0 for the default), got " +
               std::to_string(enhancement_p_percent));
   Require(std::isfinite(enhancement_q_percent) && enhancement_q_percent != 0,
           "enhancement_q_percent must be > 0 (or < 0 for the default), got " +
               std::to_string(enhancement_q_percent));
-  dynamic.Check();
-  Require(z_th_m > 0 && std::isfinite(z_th_m), "z_th_m must be > 0, got " + std::to_string(z_th_m));
-  Require(drop_probability >= 0 && drop_probability <= 1,
-          "drop_probability must be in [0, 1], got " + std::to_string(drop_probability));
 }
 
+// A misspelt key would silently keep its default: the table rejects it.
 FilterOptions FilterOptions::FromYaml(const YAML::Node& node) {
-  FilterOptions o;
-  if (!node || node.IsNull()) return o;
-  if (!node.IsMap()) throw std::invalid_argument("filter: expected a map of options");
-  // A misspelt key would silently keep its default: reject it.
-  CheckYamlKeys(node, "filter",
-                {"enable_enhancement",
-                 "enable_dynamic_removal",
-                 "enable_distant_filter",
-                 "enhancement_keep_ratio",
-                 "enhancement_levels",
-                 "enhancement_p_percent",
-                 "enhancement_q_percent",
-                 "box_growth",
-                 "small_box_area_ratio",
-                 "background_matches_t",
-                 "d_dis_px",
-                 "d_min_px",
-                 "stage1_motion_compensation",
-                 "box_vote_ratio",
-                 "box_vote_min_matches",
-                 "dynamic_class_ids",
-                 "motion_min_inliers",
-                 "motion_inlier_px",
-                 "motion_ransac_iterations",
-                 "z_th_m",
-                 "drop_probability",
-                 "seed"});
-  o.enable_enhancement = ReadYamlKey(node, "filter", "enable_enhancement", o.enable_enhancement);
-  o.enable_dynamic_removal =
-      ReadYamlKey(node, "filter", "enable_dynamic_removal", o.enable_dynamic_removal);
-  o.enable_distant_filter =
-      ReadYamlKey(node, "filter", "enable_distant_filter", o.enable_distant_filter);
-  o.enhancement_keep_ratio =
-      ReadYamlKey(node, "filter", "enhancement_keep_ratio", o.enhancement_keep_ratio);
-  o.enhancement_levels = ReadYamlKey(node, "filter", "enhancement_levels", o.enhancement_levels);
-  o.enhancement_p_percent =
-      ReadYamlKey(node, "filter", "enhancement_p_percent", o.enhancement_p_percent);
-  o.enhancement_q_percent =
-      ReadYamlKey(node, "filter", "enhancement_q_percent", o.enhancement_q_percent);
-  o.dynamic.box_growth = ReadYamlKey(node, "filter", "box_growth", o.dynamic.box_growth);
-  o.dynamic.small_box_area_ratio =
-      ReadYamlKey(node, "filter", "small_box_area_ratio", o.dynamic.small_box_area_ratio);
-  o.dynamic.background_matches_t =
-      ReadYamlKey(node, "filter", "background_matches_t", o.dynamic.background_matches_t);
-  o.dynamic.d_dis_px = ReadYamlKey(node, "filter", "d_dis_px", o.dynamic.d_dis_px);
-  o.dynamic.d_min_px = ReadYamlKey(node, "filter", "d_min_px", o.dynamic.d_min_px);
-  o.dynamic.stage1_motion_compensation = ReadYamlKey(node, "filter", "stage1_motion_compensation",
-                                                     o.dynamic.stage1_motion_compensation);
-  o.dynamic.box_vote_ratio =
-      ReadYamlKey(node, "filter", "box_vote_ratio", o.dynamic.box_vote_ratio);
-  o.dynamic.box_vote_min_matches =
-      ReadYamlKey(node, "filter", "box_vote_min_matches", o.dynamic.box_vote_min_matches);
-  o.dynamic.dynamic_class_ids =
-      ReadYamlKey(node, "filter", "dynamic_class_ids", o.dynamic.dynamic_class_ids);
-  o.dynamic.motion_min_inliers =
-      ReadYamlKey(node, "filter", "motion_min_inliers", o.dynamic.motion_min_inliers);
-  o.dynamic.motion_inlier_px =
-      ReadYamlKey(node, "filter", "motion_inlier_px", o.dynamic.motion_inlier_px);
-  o.dynamic.motion_ransac_iterations =
-      ReadYamlKey(node, "filter", "motion_ransac_iterations", o.dynamic.motion_ransac_iterations);
-  o.z_th_m = ReadYamlKey(node, "filter", "z_th_m", o.z_th_m);
-  o.drop_probability = ReadYamlKey(node, "filter", "drop_probability", o.drop_probability);
-  o.seed = ReadYamlKey(node, "filter", "seed", o.seed);
-  o.Check();
-  return o;
+  return ReadOptions<FilterOptions>(node);
 }
+
+YAML::Node FilterOptions::ToYaml() const { return Table().Write(*this); }
 
 FeatureFilter::FeatureFilter(const FilterOptions& options) : options_(options), rng_(options.seed) {
   options_.Check();

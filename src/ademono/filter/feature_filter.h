@@ -30,7 +30,16 @@ enum class PointLabel : uint8_t {
   kDistantDropped,      // deeper than Z_th and drawn for dropping
   kDynamicBoxVote,      // large box, unmatched, in a box whose matched points mostly moved
 };
+inline constexpr int kNumPointLabels = 7;
+static_assert(static_cast<int>(PointLabel::kDynamicBoxVote) + 1 == kNumPointLabels,
+              "kNumPointLabels must follow the last label");
 const char* PointLabelName(PointLabel label);
+// A label of dynamic interference removal (small box, stage 1, stage 2, box vote): the point
+// lies on something the filter judged to move.
+constexpr bool IsDynamic(PointLabel label) {
+  return label == PointLabel::kDynamicSmallBox || label == PointLabel::kDynamicStage1 ||
+         label == PointLabel::kDynamicStage2 || label == PointLabel::kDynamicBoxVote;
+}
 
 struct FilterOptions {
   bool enable_enhancement = true;
@@ -50,6 +59,9 @@ struct FilterOptions {
 
   void Check() const;                                     // throws std::invalid_argument
   static FilterOptions FromYaml(const YAML::Node& node);  // the `filter:` sub-node
+  YAML::Node ToYaml() const;
+  static const OptionsTable<FilterOptions>& Table();  // core/options_table.h
+  bool operator==(const FilterOptions&) const = default;
 };
 
 // What the filter needs of the previous frame for the two-stage dynamic test.

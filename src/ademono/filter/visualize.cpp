@@ -11,7 +11,8 @@
 namespace ademono {
 namespace {
 
-constexpr std::array<PointLabel, 7> kAllLabels{
+// Legend order; the size makes a new label a compile error here until it gets a colour.
+constexpr std::array<PointLabel, kNumPointLabels> kAllLabels{
     PointLabel::kKept,          PointLabel::kEnhancementDropped, PointLabel::kDynamicSmallBox,
     PointLabel::kDynamicStage1, PointLabel::kDynamicStage2,      PointLabel::kDynamicBoxVote,
     PointLabel::kDistantDropped};

@@ -2,15 +2,21 @@
 
 #include <stdexcept>
 
+#include "ademono/core/options_table.h"
 #include "ademono/optimize/residuals.h"
 
 namespace ademono {
 
-void BundleAdjustmentOptions::Check() const {
-  if (first_iterations < 1 || second_iterations < 0) {
-    throw std::invalid_argument("bundle adjustment: iteration counts must be positive");
-  }
+const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
+  using B = BundleAdjustmentOptions;
+  static const auto table =
+      OptionsTable<B>("mapping")
+          .Add("ba_first_iterations", &B::first_iterations, Range::AtLeast(1))
+          .Add("ba_second_iterations", &B::second_iterations, Range::AtLeast(0));
+  return table;
 }
+
+void BundleAdjustmentOptions::Check() const { Table().CheckRanges(*this); }
 
 namespace {
 

@@ -11,10 +11,16 @@
 
 namespace ademono {
 
+template <typename Options>
+class OptionsTable;
+
 struct BundleAdjustmentOptions {
   int first_iterations = 5;
   int second_iterations = 10;
   void Check() const;  // throws std::invalid_argument
+  // Its keys in the flat `mapping:` node: ba_first_iterations, ba_second_iterations.
+  static const OptionsTable<BundleAdjustmentOptions>& Table();
+  bool operator==(const BundleAdjustmentOptions&) const = default;
 };
 
 struct BaCamera {

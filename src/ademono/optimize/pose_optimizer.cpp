@@ -2,16 +2,21 @@
 
 #include <stdexcept>
 
+#include "ademono/core/options_table.h"
 #include "ademono/optimize/residuals.h"
 
 namespace ademono {
 
-void PoseOptimizerOptions::Check() const {
-  if (rounds < 1) throw std::invalid_argument("pose optimiser: rounds must be >= 1");
-  if (iterations_per_round < 1) {
-    throw std::invalid_argument("pose optimiser: iterations_per_round must be >= 1");
-  }
+const OptionsTable<PoseOptimizerOptions>& PoseOptimizerOptions::Table() {
+  using P = PoseOptimizerOptions;
+  static const auto table =
+      OptionsTable<P>("optimizer")
+          .Add("pose_rounds", &P::rounds, Range::AtLeast(1))
+          .Add("pose_iterations_per_round", &P::iterations_per_round, Range::AtLeast(1));
+  return table;
 }
+
+void PoseOptimizerOptions::Check() const { Table().CheckRanges(*this); }
 
 PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
                                     const Rigid3d& initial_cam_from_world,

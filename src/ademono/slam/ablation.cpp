@@ -100,11 +100,6 @@ SyntheticTruth::SyntheticTruth(const fs::path& sequence_dir) : masks_dir_(sequen
 
 namespace {
 
-bool IsDynamicLabel(PointLabel label) {
-  return label == PointLabel::kDynamicSmallBox || label == PointLabel::kDynamicStage1 ||
-         label == PointLabel::kDynamicStage2 || label == PointLabel::kDynamicBoxVote;
-}
-
 cv::Point Pixel(const cv::KeyPoint& kp, const cv::Size& size) {
   return {std::clamp(static_cast<int>(std::lround(kp.pt.x)), 0, size.width - 1),
           std::clamp(static_cast<int>(std::lround(kp.pt.y)), 0, size.height - 1)};
@@ -139,7 +134,7 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
     const cv::Point p = Pixel(keypoints[i], mask.size());
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
     if (labels[i] == PointLabel::kEnhancementDropped) continue;
-    const bool dynamic = IsDynamicLabel(labels[i]);
+    const bool dynamic = IsDynamic(labels[i]);
     if (mask.at<uint8_t>(p) > 127) {
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;

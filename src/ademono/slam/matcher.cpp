@@ -1,67 +1,12 @@
 #include "ademono/slam/matcher.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <opencv2/features2d.hpp>
 
 #include "ademono/feature/orb_extractor.h"
 
 namespace ademono {
-namespace {
-
-float AngleDiff(float a, float b) {
-  float rot = a - b;
-  if (rot < 0.f) rot += 360.f;
-  return rot;
-}
-
-}  // namespace
-
-std::vector<size_t> Matcher::RotationOutliers(
-    const std::vector<std::pair<size_t, float>>& rotations) {
-  std::array<std::vector<size_t>, kHistogramBins> bins;
-  const float factor = kHistogramBins / 360.f;
-  for (const auto& [idx, rot] : rotations) {
-    int bin = static_cast<int>(std::round(rot * factor));
-    if (bin == kHistogramBins) bin = 0;
-    bin = std::clamp(bin, 0, kHistogramBins - 1);
-    bins[bin].push_back(idx);
-  }
-  // The three fullest bins; a bin with less than 10% of the first is dropped (ORB-SLAM).
-  int i1 = -1, i2 = -1, i3 = -1;
-  size_t m1 = 0, m2 = 0, m3 = 0;
-  for (int i = 0; i < kHistogramBins; ++i) {
-    const size_t s = bins[i].size();
-    if (s > m1) {
-      m3 = m2;
-      i3 = i2;
-      m2 = m1;
-      i2 = i1;
-      m1 = s;
-      i1 = i;
-    } else if (s > m2) {
-      m3 = m2;
-      i3 = i2;
-      m2 = s;
-      i2 = i;
-    } else if (s > m3) {
-      m3 = s;
-      i3 = i;
-    }
-  }
-  if (m2 < 0.1 * m1)
-    i2 = i3 = -1;
-  else if (m3 < 0.1 * m1)
-    i3 = -1;
-  std::vector<size_t> outliers;
-  for (int i = 0; i < kHistogramBins; ++i) {
-    if (i == i1 || i == i2 || i == i3) continue;
-    outliers.insert(outliers.end(), bins[i].begin(), bins[i].end());
-  }
-  return outliers;
-}
-
 int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius) const {
   const FrameFeatures& cf = current.F();
   const FrameFeatures& lf = last.F();
@@ -73,7 +18,7 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
   const bool forward = last_from_current_t.z() > baseline;
   const bool backward = -last_from_current_t.z() > baseline;
 
-  std::vector<std::pair<size_t, float>> rotations;
+  RotationHistogram rotations;
   int matches = 0;
   for (size_t i = 0; i < last.map_points.size(); ++i) {
     const auto& point = last.map_points[i];
@@ -107,18 +52,18 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
         best_idx = idx;
       }
     }
-    if (best_dist <= kThHigh) {
+    if (best_dist <= kOrbDistanceHigh) {
       current.map_points[best_idx] = point;
       ++matches;
       if (check_orientation_) {
-        rotations.emplace_back(best_idx,
-                               AngleDiff(lf.keypoints[i].angle, cf.keypoints[best_idx].angle));
+        rotations.Add(lf.keypoints[i].angle, cf.keypoints[best_idx].angle,
+                      static_cast<int>(best_idx));
       }
     }
   }
   if (check_orientation_) {
-    for (size_t idx : RotationOutliers(rotations)) {
-      current.map_points[idx].reset();
+    for (const int idx : rotations.InconsistentMatches()) {
+      current.map_points[static_cast<size_t>(idx)].reset();
       --matches;
     }
   }
@@ -157,7 +102,7 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
         best_level2 = f.keypoints_un[idx].octave;
       }
     }
-    if (best_dist <= kThHigh) {
+    if (best_dist <= kOrbDistanceHigh) {
       if (best_level == best_level2 && best_dist > nn_ratio_ * best_dist2) continue;
       frame.map_points[best_idx] = point;
       ++matches;
@@ -171,7 +116,7 @@ int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float ra
   const FrameFeatures& f = frame.F();
   const Rigid3d& cam_from_world = *frame.cam_from_world;
   const Eigen::Vector3d center = frame.CameraCenter();
-  std::vector<std::pair<size_t, float>> rotations;
+  RotationHistogram rotations;
   int matches = 0;
   for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
     const auto& point = keyframe.map_points[i];
@@ -202,14 +147,14 @@ int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float ra
       frame.map_points[best_idx] = point;
       ++matches;
       if (check_orientation_) {
-        rotations.emplace_back(
-            best_idx, AngleDiff(keyframe.F().keypoints[i].angle, f.keypoints[best_idx].angle));
+        rotations.Add(keyframe.F().keypoints[i].angle, f.keypoints[best_idx].angle,
+                      static_cast<int>(best_idx));
       }
     }
   }
   if (check_orientation_) {
-    for (size_t idx : RotationOutliers(rotations)) {
-      frame.map_points[idx].reset();
+    for (const int idx : rotations.InconsistentMatches()) {
+      frame.map_points[static_cast<size_t>(idx)].reset();
       --matches;
     }
   }
@@ -242,7 +187,7 @@ int Matcher::SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
     if (m.empty()) continue;
     const int best = static_cast<int>(m[0].distance);
     const int second = m.size() > 1 ? static_cast<int>(m[1].distance) : 256;
-    if (best > kThLow || best >= nn_ratio_ * second) continue;
+    if (best > kOrbDistanceLow || best >= nn_ratio_ * second) continue;
     const size_t best_k = static_cast<size_t>(m[0].trainIdx);
     // Keep one frame keypoint per keyframe keypoint: the closest (lowest index on ties).
     if (best < best_for_kf[best_k]) {
@@ -250,18 +195,18 @@ int Matcher::SearchByDescriptor(const KeyFrame& keyframe, const Frame& frame,
       best_frame_for_kf[best_k] = m[0].queryIdx;
     }
   }
-  std::vector<std::pair<size_t, float>> rotations;
+  RotationHistogram rotations;
   int n = 0;
   for (size_t k = 0; k < kf_indices.size(); ++k) {
     if (best_frame_for_kf[k] < 0) continue;
     const size_t j = static_cast<size_t>(best_frame_for_kf[k]);
     matches[j] = keyframe.map_points[kf_indices[k]];
     ++n;
-    rotations.emplace_back(j, AngleDiff(kf.keypoints[kf_indices[k]].angle, f.keypoints[j].angle));
+    rotations.Add(kf.keypoints[kf_indices[k]].angle, f.keypoints[j].angle, static_cast<int>(j));
   }
   if (check_orientation_) {
-    for (size_t j : RotationOutliers(rotations)) {
-      matches[j].reset();
+    for (const int j : rotations.InconsistentMatches()) {
+      matches[static_cast<size_t>(j)].reset();
       --n;
     }
   }
@@ -321,7 +266,7 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
         best_idx = idx;
       }
     }
-    if (best_dist > kThLow) continue;
+    if (best_dist > kOrbDistanceLow) continue;
     const std::shared_ptr<MapPoint> existing = keyframe.map_points[best_idx];
     if (existing && !existing->bad) {
       if (existing->NumObservations() > point->NumObservations()) {

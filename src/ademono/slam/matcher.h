@@ -2,11 +2,13 @@
 // Descriptor matching for tracking and mapping (after ORB-SLAM's ORBmatcher): search by
 // projection with a window radius by scale level (and viewing angle), Hamming thresholds, a
 // ratio test between the two best candidates and rotation consistency (a 30-bin histogram of
-// keypoint angle differences; only the three fullest bins are kept).
+// keypoint angle differences; only the three fullest bins are kept). The thresholds and the
+// histogram are the feature module's (feature/matching.h).
 
 #include <memory>
 #include <vector>
 
+#include "ademono/feature/matching.h"
 #include "ademono/slam/frame.h"
 #include "ademono/slam/keyframe.h"
 #include "ademono/slam/map.h"
@@ -15,10 +17,6 @@ namespace ademono {
 
 class Matcher {
  public:
-  static constexpr int kThHigh = 100;
-  static constexpr int kThLow = 50;
-  static constexpr int kHistogramBins = 30;
-
   Matcher(float nn_ratio, bool check_orientation)
       : nn_ratio_(nn_ratio), check_orientation_(check_orientation) {}
 
@@ -59,10 +57,6 @@ class Matcher {
   static float RadiusByViewingCos(float view_cos) { return view_cos > 0.998f ? 2.5f : 4.0f; }
 
  private:
-  // Indices of the matches to drop because their rotation is not among the 3 main bins.
-  static std::vector<size_t> RotationOutliers(
-      const std::vector<std::pair<size_t, float>>& rotations);
-
   float nn_ratio_;
   bool check_orientation_;
 };

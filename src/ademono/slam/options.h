@@ -10,14 +10,22 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <string>
 
 #include "ademono/core/depth_error.h"
+#include "ademono/detect/detector_factory.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/pose_optimizer.h"
 
 namespace ademono {
+
+template <typename Options>
+class OptionsTable;
+
+// Each struct's keys are one field table (Table(), core/options_table.h) that drives FromYaml
+// (strict: unknown keys rejected), the range part of Check() and ToYaml().
 
 // How per-keypoint depth is read from the depth map (`depth:` node).
 struct FrameDepthOptions {
@@ -53,6 +61,9 @@ struct FrameDepthOptions {
   double CloseDepth() const { return close_depth_factor * virtual_baseline; }
   void Check() const;  // throws std::invalid_argument
   static FrameDepthOptions FromYaml(const YAML::Node& node);
+  YAML::Node ToYaml() const;
+  static const OptionsTable<FrameDepthOptions>& Table();
+  bool operator==(const FrameDepthOptions&) const = default;
 };
 
 struct TrackingOptions {
@@ -76,6 +87,9 @@ struct TrackingOptions {
   int dynamic_cull_hits = 3;          // map points seen this often inside dynamic boxes are culled
   void Check() const;
   static TrackingOptions FromYaml(const YAML::Node& node);
+  YAML::Node ToYaml() const;
+  static const OptionsTable<TrackingOptions>& Table();
+  bool operator==(const TrackingOptions&) const = default;
 };
 
 struct MappingOptions {
@@ -98,9 +112,12 @@ struct MappingOptions {
   int triangulation_neighbours = 10;
   double triangulation_min_parallax_deg = 1.0;
   double triangulation_depth_sigmas = 3.0;
-  BundleAdjustmentOptions ba;
+  BundleAdjustmentOptions ba;  // keys ba_first_iterations, ba_second_iterations
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);
+  YAML::Node ToYaml() const;
+  static const OptionsTable<MappingOptions>& Table();
+  bool operator==(const MappingOptions&) const = default;
 };
 
 struct SystemOptions {
@@ -109,10 +126,23 @@ struct SystemOptions {
   FrameDepthOptions depth;
   TrackingOptions tracking;
   MappingOptions mapping;
-  PoseOptimizerOptions pose;
+  PoseOptimizerOptions pose;  // the `optimizer:` node
   void Check() const;
-  // Reads every sub-node of a config file's root. InputError "path: ..." on any problem.
+  // Reads every sub-node of a config file's root. InputError "path: ..." on any problem, also for
+  // an unknown key in `detector:` (DetectorOptions, read by the caller) and an unknown section.
   static SystemOptions FromYaml(const YAML::Node& root, const std::filesystem::path& path);
+  // Every key of every section, the resolved options: FromYaml(ToYaml()) == *this.
+  YAML::Node ToYaml() const;
+  static const OptionsTable<SystemOptions>& Table();
+  bool operator==(const SystemOptions&) const = default;
 };
+
+// The resolved options of a run as a config file: every key of every section, `detector:`
+// included, so that SystemOptions::FromYaml and DetectorOptions::FromYaml read it back to the
+// same values (a run repeated exactly). WriteResolvedConfig writes it atomically
+// (config.resolved.yaml in a run's output folder).
+std::string ResolvedConfigText(const SystemOptions& system, const DetectorOptions& detector);
+void WriteResolvedConfig(const std::filesystem::path& path, const SystemOptions& system,
+                         const DetectorOptions& detector);
 
 }  // namespace ademono

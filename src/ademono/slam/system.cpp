@@ -183,10 +183,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
       if (labels[i] == PointLabel::kEnhancementDropped || !d.box.contains(keypoints[i].pt))
         continue;
       ++judged;
-      dynamic += labels[i] == PointLabel::kDynamicSmallBox ||
-                 labels[i] == PointLabel::kDynamicStage1 ||
-                 labels[i] == PointLabel::kDynamicStage2 ||
-                 labels[i] == PointLabel::kDynamicBoxVote;
+      dynamic += IsDynamic(labels[i]);
     }
     if (judged > 0 && dynamic >= options_.filter.dynamic.box_vote_ratio * judged)
       moving_detections.push_back(d);

@@ -1,0 +1,63 @@
+#include "ademono/slam/map.h"
+
+#include <gtest/gtest.h>
+
+#include "frame_test_util.h"
+
+namespace ademono {
+namespace {
+
+using testing_util::TestFeatures;
+
+TEST(MapTest, ErasingAKeyFrameThatHoldsTheLastReferenceToAPoint) {
+  // A keyframe can still hold a point the map has already erased (it was in the keyframe but not
+  // among the point's observations). Erasing the keyframe then drops the last owner of the point:
+  // the point must stay alive until its bookkeeping is done (this was a use after free, found by
+  // AddressSanitizer on the synthetic office).
+  Map map;
+  const auto features = TestFeatures({{100, 100}, {200, 150}}, {1.5f, 2.0f}, 3);
+  Frame f0(0, 0, 0.0, features), f1(1, 1, 0.1, features);
+  f0.cam_from_world = f1.cam_from_world = Rigid3d::Identity();
+  auto kf0 = map.CreateKeyFrame(f0);
+  auto kf1 = map.CreateKeyFrame(f1);  // the first keyframe is never erased; this one can be
+  auto point = map.CreateMapPoint(Eigen::Vector3d(0, 0, 2), kf1.get(), 1);
+  kf1->AddMapPoint(point, 0);
+  map.ErasePoint(point.get());  // no observations: kf1 keeps its pointer
+  ASSERT_EQ(point.use_count(), 2);
+  point.reset();  // kf1 is now the only owner (no weak_ptr: it would keep the memory allocated)
+  map.EraseKeyFrame(kf1.get());
+  EXPECT_TRUE(kf1->bad);
+  EXPECT_EQ(kf1->map_points[0], nullptr);
+  EXPECT_EQ(map.NumMapPoints(), 0u);
+}
+
+TEST(MapTest, ReplaceAndEraseKeepObservationsConsistent) {
+  Map map;
+  const auto f = TestFeatures({{100, 100}, {200, 150}}, {1.5f, 2.0f}, 3);
+  Frame frame(0, 0, 0.0, f);
+  frame.cam_from_world = Rigid3d::Identity();
+  auto kf0 = map.CreateKeyFrame(frame);
+  auto kf1 = map.CreateKeyFrame(frame);
+  auto a = map.CreateMapPoint(Eigen::Vector3d(0, 0, 1.5), kf0.get(), 0);
+  auto b = map.CreateMapPoint(Eigen::Vector3d(0, 0, 1.5), kf1.get(), 0);
+  a->AddObservation(kf0.get(), 0);
+  kf0->AddMapPoint(a, 0);
+  b->AddObservation(kf1.get(), 0);
+  kf1->AddMapPoint(b, 0);
+  map.ReplacePoint(b.get(), a);
+  EXPECT_TRUE(b->bad);
+  EXPECT_EQ(MapPoint::Resolve(b), a);
+  EXPECT_EQ(a->NumObservations(), 2);
+  EXPECT_EQ(kf1->map_points[0], a);
+  EXPECT_EQ(map.NumMapPoints(), 1u);
+  kf1->UpdateConnections();
+  map.EraseKeyFrame(kf1.get());
+  EXPECT_TRUE(kf1->bad);
+  EXPECT_EQ(a->NumObservations(), 1);
+  EXPECT_EQ(map.NumKeyFrames(), 1u);
+  map.EraseKeyFrame(kf0.get());  // the first keyframe stays
+  EXPECT_FALSE(kf0->bad);
+}
+
+}  // namespace
+}  // namespace ademono

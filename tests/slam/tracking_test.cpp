@@ -1,0 +1,72 @@
+// Tracking on the synthetic office (tests/slam/synthetic_sequence.h): exact depth, ground-truth
+// boxes of the walking persons, no ../shared needed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "ademono/slam/system.h"
+#include "synthetic_sequence.h"
+
+namespace ademono {
+namespace {
+
+using testing_util::SyntheticOffice;
+
+struct RunResult {
+  std::vector<TrackResult> results;
+  Trajectory trajectory;
+};
+
+RunResult TrackAll(const SyntheticOffice& sequence, const SystemOptions& options) {
+  System system(sequence.GetCamera(), options);
+  RunResult run;
+  for (size_t i = 0; i < sequence.Size(); ++i) {
+    const FrameData frame = sequence.Load(i);
+    run.results.push_back(system.TrackFrame(frame, frame.depth, sequence.Detections(i)));
+  }
+  system.Shutdown();
+  run.trajectory = system.FrameTrajectory();
+  return run;
+}
+
+// Position errors against the ground truth expressed in the first camera (the SLAM world): exact
+// depth gives metric scale, so no alignment.
+std::vector<double> PositionErrors(const SyntheticOffice& sequence, const Trajectory& trajectory) {
+  const Rigid3d first_from_world = sequence.WorldFromCam(0).inverse();
+  std::vector<double> errors;
+  for (const StampedPose& p : trajectory) {
+    const size_t i = static_cast<size_t>(std::lround(p.timestamp * 30.0));
+    const Rigid3d gt = first_from_world * sequence.WorldFromCam(i);
+    errors.push_back((gt.translation() - p.world_from_cam.translation()).norm());
+  }
+  return errors;
+}
+
+TEST(TrackingTest, TracksEveryFrameOfTheSyntheticOffice) {
+  const SyntheticOffice sequence;
+  ASSERT_EQ(sequence.Size(), 80u);
+  const RunResult run = TrackAll(sequence, SystemOptions{});
+  ASSERT_EQ(run.results.size(), 80u);
+  for (const TrackResult& r : run.results) EXPECT_TRUE(r.tracked) << "frame " << r.index;
+  EXPECT_TRUE(run.results.front().new_keyframe);
+  ASSERT_EQ(run.trajectory.size(), 80u);
+  const std::vector<double> errors = PositionErrors(sequence, run.trajectory);
+  double sum2 = 0;
+  for (double e : errors) sum2 += e * e;
+  const double ate_rmse = std::sqrt(sum2 / static_cast<double>(errors.size()));
+  const double worst = *std::max_element(errors.begin(), errors.end());
+  RecordProperty("ate_rmse_mm", static_cast<int>(std::lround(ate_rmse * 1000)));
+  RecordProperty("worst_mm", static_cast<int>(std::lround(worst * 1000)));
+  EXPECT_LT(ate_rmse, 0.02);  // 7 mm measured
+  EXPECT_LT(worst, 0.05);     // 14 mm measured
+  // The persons are in view: the dynamic filter removes points on them in some frames.
+  int dynamic = 0;
+  for (const TrackResult& r : run.results) {
+    for (PointLabel label : r.labels) dynamic += IsDynamic(label);
+  }
+  EXPECT_GT(dynamic, 0);
+}
+
+}  // namespace
+}  // namespace ademono
