@@ -135,9 +135,9 @@ std::vector<Eigen::Matrix4d> PosesFromArray(const py::handle& array, const char*
 }
 
 py::tuple SeriesToTuple(const PoseSeries& s) {
-  return py::make_tuple(py::array_t<double>(static_cast<py::ssize_t>(s.timestamps.size()),
-                                            s.timestamps.data()),
-                        PosesToArray(s.world_from_cam));
+  return py::make_tuple(
+      py::array_t<double>(static_cast<py::ssize_t>(s.timestamps.size()), s.timestamps.data()),
+      PosesToArray(s.world_from_cam));
 }
 
 py::tuple TrajectoryToTuple(const Trajectory& t) { return SeriesToTuple(ToPoseSeries(t)); }
@@ -217,8 +217,7 @@ struct PyTrackResult {
 std::pair<YAML::Node, fs::path> ConfigNode(const py::object& config) {
   if (config.is_none()) return {YAML::Node(), fs::path()};
   if (py::isinstance<py::dict>(config)) {
-    const std::string text =
-        py::module_::import("json").attr("dumps")(config).cast<std::string>();
+    const std::string text = py::module_::import("json").attr("dumps")(config).cast<std::string>();
     try {
       return {YAML::Load(text), fs::path("<config dict>")};
     } catch (const YAML::Exception& e) {
@@ -412,8 +411,8 @@ py::object Evaluate(const py::object& gt_arg, const py::object& est_arg, const s
   // As `ademono eval`: without timestamps on either side, match by frame (by the written index
   // when a file is indexed KITTI).
   options.associate_by_timestamp = !gt.HasFrameIndices() && !est.HasFrameIndices();
-  options.associate_by_frame_index = gt.format == TrajectoryFormat::kKittiIndexed ||
-                                     est.format == TrajectoryFormat::kKittiIndexed;
+  options.associate_by_frame_index =
+      gt.format == TrajectoryFormat::kKittiIndexed || est.format == TrajectoryFormat::kKittiIndexed;
   if (options.associate_by_frame_index && !(gt.HasFrameIndices() && est.HasFrameIndices())) {
     throw std::invalid_argument(
         "an indexed KITTI trajectory matches poses by frame index and cannot be compared with a "
@@ -425,8 +424,8 @@ py::object Evaluate(const py::object& gt_arg, const py::object& est_arg, const s
     r = EvaluateTrajectories(gt, est, options);
   }
   py::dict out = JsonToPython(ToJson(r));
-  out["ape_errors"] = py::array_t<double>(static_cast<py::ssize_t>(r.ape_errors.size()),
-                                          r.ape_errors.data());
+  out["ape_errors"] =
+      py::array_t<double>(static_cast<py::ssize_t>(r.ape_errors.size()), r.ape_errors.data());
   out["gt_matched"] = SeriesToTuple(r.gt_matched);
   out["est_aligned"] = SeriesToTuple(r.est_aligned);
   return out;
@@ -489,8 +488,7 @@ PYBIND11_MODULE(ademono, m) {
   py::class_<PySequence>(m, "Sequence", "A dataset sequence; index it or iterate over it")
       .def("__len__", &PySequence::Size)
       .def("__getitem__", py::overload_cast<py::ssize_t>(&PySequence::Get, py::const_))
-      .def_property_readonly("camera",
-                             [](const PySequence& s) { return s.Get().GetCamera(); })
+      .def_property_readonly("camera", [](const PySequence& s) { return s.Get().GetCamera(); })
       .def_property_readonly("kind", [](const PySequence& s) { return s.Get().Kind(); })
       .def_property_readonly("path", [](const PySequence& s) { return s.Get().Path().string(); })
       .def_property_readonly("has_depth", [](const PySequence& s) { return s.Get().HasDepth(); })
@@ -515,15 +513,13 @@ PYBIND11_MODULE(ademono, m) {
              d.class_name = class_name;
              return d;
            }),
-           py::arg("box"), py::arg("class_id"), py::arg("score") = 1.0f,
-           py::arg("class_name") = "")
+           py::arg("box"), py::arg("class_id"), py::arg("score") = 1.0f, py::arg("class_name") = "")
       .def_readonly("class_id", &Detection::class_id)
       .def_readonly("class_name", &Detection::class_name)
       .def_readonly("score", &Detection::score)
       .def_property_readonly("box",
                              [](const Detection& d) {
-                               return py::make_tuple(d.box.x, d.box.y, d.box.width,
-                                                     d.box.height);
+                               return py::make_tuple(d.box.x, d.box.y, d.box.width, d.box.height);
                              })
       .def("__repr__", [](const Detection& d) {
         return "Detection(" + d.class_name + ", score=" + std::to_string(d.score) + ")";
@@ -543,8 +539,8 @@ PYBIND11_MODULE(ademono, m) {
       .def_readonly("keypoints", &PyTrackResult::keypoints);
 
   py::class_<PySystem>(m, "System", "The SLAM system: call track() once per frame, in order")
-      .def(py::init<const py::object&, const Camera&, std::optional<uint64_t>>(),
-           py::arg("config"), py::arg("camera"), py::arg("seed") = py::none(),
+      .def(py::init<const py::object&, const Camera&, std::optional<uint64_t>>(), py::arg("config"),
+           py::arg("camera"), py::arg("seed") = py::none(),
            "config: a YAML file path (e.g. configs/7scenes.yaml), a dict of the same keys, or "
            "None for the defaults")
       .def("track", &PySystem::Track, py::arg("image"), py::arg("depth") = py::none(),
@@ -553,8 +549,7 @@ PYBIND11_MODULE(ademono, m) {
            "(default: the frame number); detections: list of Detection")
       .def("shutdown", &PySystem::Shutdown)
       .def(
-          "trajectory",
-          [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
+          "trajectory", [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
           "(timestamps (N,), world_from_cam (N, 4, 4)) of the tracked frames")
       .def(
           "keyframes", [](PySystem& s) { return TrajectoryToTuple(s.Get().KeyFrameTrajectory()); },
@@ -624,8 +619,8 @@ PYBIND11_MODULE(ademono, m) {
   m.def(
       "ate",
       [](const py::object& gt, const py::object& est, const std::string& align) {
-        const py::dict r = Evaluate(gt, est, align, 0.01, 1.0, "frames", false, std::nullopt,
-                                    "auto");
+        const py::dict r =
+            Evaluate(gt, est, align, 0.01, 1.0, "frames", false, std::nullopt, "auto");
         return r["ape"]["rmse"].cast<double>();
       },
       py::arg("gt"), py::arg("est"), py::arg("align") = "se3", "ATE: APE translation RMSE (m)");
@@ -642,8 +637,7 @@ PYBIND11_MODULE(ademono, m) {
   m.def(
       "kitti_metrics",
       [](const py::object& gt, const py::object& est, const std::string& align) {
-        const py::dict r =
-            Evaluate(gt, est, "none", 0.01, 1.0, "frames", true, align, "auto");
+        const py::dict r = Evaluate(gt, est, "none", 0.01, 1.0, "frames", true, align, "auto");
         return py::object(r["kitti"]);  // an accessor would outlive `r`
       },
       py::arg("gt"), py::arg("est"), py::arg("align") = "6dof",
@@ -652,8 +646,8 @@ PYBIND11_MODULE(ademono, m) {
   m.def(
       "synth",
       [](const fs::path& out, const std::string& scene, size_t frames, uint64_t seed,
-         const std::optional<std::string>& motion, int persons, int width, int height,
-         double noise, double blur) {
+         const std::optional<std::string>& motion, int persons, int width, int height, double noise,
+         double blur) {
         synth::GeneratorOptions options;
         options.scene.scene = scene;
         if (motion) options.scene.motion = synth::ParseMotionKind(*motion);

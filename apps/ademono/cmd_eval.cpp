@@ -14,8 +14,8 @@
 
 namespace {
 
-const std::vector<std::string> kFormatNames = {"auto",          "tum",   "orbslam", "kitti",
-                                               "kitti-indexed", "euroc"};
+const std::vector<std::string> kFormatNames = {"auto",  "tum",           "orbslam",
+                                               "kitti", "kitti-indexed", "euroc"};
 
 struct EvalArgs {
   std::string gt, format = "auto", gt_format, est_format, align = "se3", rpe_unit = "frames",
@@ -60,10 +60,11 @@ ademono::EvalResult Evaluate(const LoadedFile& gt, const LoadedFile& est,
   options.associate_by_frame_index = gt_indexed || est_indexed;
   if (options.associate_by_frame_index &&
       !(gt.poses.HasFrameIndices() && est.poses.HasFrameIndices())) {
-    throw InputError("an indexed KITTI file matches poses by frame index and cannot be compared "
-                     "with a timestamped file: " +
-                     gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
-                     ToString(est.poses.format) + ")");
+    throw InputError(
+        "an indexed KITTI file matches poses by frame index and cannot be compared "
+        "with a timestamped file: " +
+        gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
+        ToString(est.poses.format) + ")");
   }
   try {
     return EvaluateTrajectories(gt.poses, est.poses, options);
@@ -84,9 +85,9 @@ std::string FormatTable(const std::vector<LoadedFile>& ests,
   const bool kitti = results.front().kitti.has_value();
   std::string out;
   char buf[512];
-  std::snprintf(buf, sizeof(buf), "%-*s %7s %10s %10s %10s %10s %10s %12s %12s", static_cast<int>(name_width),
-                "estimate", "matched", "APE rmse", "APE mean", "APE median", "APE max", "APE std",
-                "RPE t rmse", "RPE r rmse");
+  std::snprintf(buf, sizeof(buf), "%-*s %7s %10s %10s %10s %10s %10s %12s %12s",
+                static_cast<int>(name_width), "estimate", "matched", "APE rmse", "APE mean",
+                "APE median", "APE max", "APE std", "RPE t rmse", "RPE r rmse");
   out += buf;
   if (kitti) {
     std::snprintf(buf, sizeof(buf), " %9s %11s", "t_rel %", "r_rel d/100m");
@@ -96,8 +97,9 @@ std::string FormatTable(const std::vector<LoadedFile>& ests,
   for (size_t k = 0; k < results.size(); ++k) {
     const EvalResult& r = results[k];
     std::snprintf(buf, sizeof(buf), "%-*s %7zu %10.6f %10.6f %10.6f %10.6f %10.6f %12.6f %12.6f",
-                  static_cast<int>(name_width), ests[k].path.c_str(), r.matched_poses, r.ape.rmse, r.ape.mean,
-                  r.ape.median, r.ape.max, r.ape.std, r.rpe_trans.rmse, r.rpe_rot_deg.rmse);
+                  static_cast<int>(name_width), ests[k].path.c_str(), r.matched_poses, r.ape.rmse,
+                  r.ape.mean, r.ape.median, r.ape.max, r.ape.std, r.rpe_trans.rmse,
+                  r.rpe_rot_deg.rmse);
     out += buf;
     if (kitti) {
       std::snprintf(buf, sizeof(buf), " %9.3f %11.3f", r.kitti->t_rel_percent,
@@ -106,7 +108,8 @@ std::string FormatTable(const std::vector<LoadedFile>& ests,
     }
     out += "\n";
   }
-  std::snprintf(buf, sizeof(buf), "(APE in m after %s alignment; RPE over %g %s, t in m, r in deg)\n",
+  std::snprintf(buf, sizeof(buf),
+                "(APE in m after %s alignment; RPE over %g %s, t in m, r in deg)\n",
                 ToString(results.front().alignment).c_str(), results.front().rpe_delta,
                 results.front().rpe_unit == DeltaUnit::kFrames ? "frames" : "m");
   out += buf;
@@ -138,9 +141,8 @@ int RunEval(const EvalArgs& a) {
   std::string json, svg;
   if (!a.json.empty()) {
     auto describe = [](const LoadedFile& f) {
-      return nlohmann::json{{"file", f.path},
-                            {"format", ToString(f.poses.format)},
-                            {"format_detected", f.detected}};
+      return nlohmann::json{
+          {"file", f.path}, {"format", ToString(f.poses.format)}, {"format_detected", f.detected}};
     };
     nlohmann::json j;
     if (results.size() == 1) {

@@ -134,7 +134,10 @@ def test_bad_inputs_raise(tmp_path):
     with pytest.raises(ademono.InputError, match="missing.yaml: no such file"):
         ademono.System(str(tmp_path / "missing.yaml"), ademono.Camera(64, 48, 50, 50, 32, 24))
     camera = ademono.Camera(64, 48, 50, 50, 32, 24)
-    system = ademono.System(None, camera)
+    # A dict config goes through the same strict reader as a file.
+    with pytest.raises(ademono.InputError, match=r"<config dict>: unknown key 'tracking.nope'"):
+        ademono.System({"tracking": {"nope": 2}}, camera)
+    system = ademono.System({"orb": {"num_features": 500}}, camera)
     with pytest.raises(ademono.InputError, match="image size 32x48 differs"):
         system.track(np.zeros((48, 32, 3), np.uint8))
     with pytest.raises(ValueError, match="uint8"):

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <fstream>
-#include <sstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli_test_util.h"
 
@@ -53,8 +53,8 @@ class EvalFormatsCliTest : public ::testing::Test {
 TEST_F(EvalFormatsCliTest, IndexedKittiIsDetectedAndReproducesKittiOdomEval) {
   const fs::path est = Indexed("10"), json = dir_ / "k.json";
   const std::string gt = (kTraj / "kitti-odom-eval/gt/10.txt").string();
-  const auto r = Run("--gt " + gt + " --est " + est.string() + " --kitti-align 7dof --json " +
-                     json.string());
+  const auto r =
+      Run("--gt " + gt + " --est " + est.string() + " --kitti-align 7dof --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("ground truth: " + gt + " (kitti, detected, 1201 poses)"));
   EXPECT_THAT(r.out, HasSubstr("estimate: " + est.string() + " (kitti-indexed, detected"));
@@ -105,7 +105,8 @@ TEST_F(EvalFormatsCliTest, SeveralEstimatesOneTableJsonAndPlot) {
   EXPECT_THAT(r.out, HasSubstr("estimate: " + b.string() + " (euroc, detected, 788 poses)"));
   // One header row and one row per estimate, APE rmse as evo prints it (6 decimals here).
   char rmse[32];
-  std::snprintf(rmse, sizeof(rmse), "%.6f", expected_["evo"]["fr1_xyz_rgbdslam"]["ape_se3"]["rmse"].get<double>());
+  std::snprintf(rmse, sizeof(rmse), "%.6f",
+                expected_["evo"]["fr1_xyz_rgbdslam"]["ape_se3"]["rmse"].get<double>());
   EXPECT_THAT(r.out, HasSubstr("APE rmse"));
   size_t rows = 0;
   for (size_t at = r.out.find(rmse); at != std::string::npos; at = r.out.find(rmse, at + 1)) ++rows;
@@ -152,7 +153,8 @@ TEST_F(EvalFormatsCliTest, ErrorsNameTheFilesAndWriteNothing) {
   r = Run("--gt " + tum_gt + " --est " + tum_gt + " --est " + bad.string() + " --json " +
           json.string());
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.err, HasSubstr(bad.string() + ":1: cannot tell the trajectory format from 3 fields"));
+  EXPECT_THAT(r.err,
+              HasSubstr(bad.string() + ":1: cannot tell the trajectory format from 3 fields"));
   EXPECT_FALSE(fs::exists(json));
 }
 

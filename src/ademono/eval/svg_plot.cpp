@@ -108,9 +108,8 @@ std::string RenderEvalSvg(const EvalResult& r, const std::string& title) {
 std::string RenderEvalSvg(const std::vector<NamedEvalResult>& results, const std::string& title) {
   if (results.empty()) throw std::invalid_argument("RenderEvalSvg: no results");
   // Matplotlib's tab10, without the grey used for the ground truth.
-  static constexpr const char* kColours[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e",
-                                             "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
-                                             "#17becf"};
+  static constexpr const char* kColours[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
+                                             "#8c564b", "#e377c2", "#bcbd22", "#17becf"};
   const EvalResult* longest = results.front().result;
   for (const auto& named : results)
     if (named.result->matched_poses > longest->matched_poses) longest = named.result;
@@ -198,8 +197,9 @@ std::string RenderEvalSvg(const std::vector<NamedEvalResult>& results, const std
       std::snprintf(rmse, sizeof(rmse), " (APE rmse %.4f m)", results[k].result->ape.rmse);
       label += rmse;
     }
-    s += "<text x=\"" + Num(top.ox + 8) + "\" y=\"" + Num(top.oy + 32 + 16 * static_cast<double>(k)) +
-         "\" fill=\"" + colour + "\">" + Escape(label) + "</text>\n";
+    s += "<text x=\"" + Num(top.ox + 8) + "\" y=\"" +
+         Num(top.oy + 32 + 16 * static_cast<double>(k)) + "\" fill=\"" + colour + "\">" +
+         Escape(label) + "</text>\n";
     s += Polyline(err_pts[k], err, results.size() == 1 ? "#1f77b4" : colour, 1.2);
   }
   s += "</svg>\n";

@@ -1,8 +1,8 @@
 #include "ademono/io/trajectory.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
-#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -117,9 +117,9 @@ KittiRows ReadKittiRows(const fs::path& path, bool accept_index, bool require_in
   ForEachDataLine(path, false, [&](size_t line, const std::vector<std::string_view>& f) {
     if (!indexed) indexed = accept_index && f.size() == 13;
     if (*indexed && f.size() != 13) {
-      ThrowInputError(path, line,
-                      "expected 13 fields (frame index and 12 pose values), found " +
-                          std::to_string(f.size()));
+      ThrowInputError(
+          path, line,
+          "expected 13 fields (frame index and 12 pose values), found " + std::to_string(f.size()));
     }
     if (!*indexed) RequireFieldCount(path, line, f, 12);
     const size_t offset = *indexed ? 1 : 0;
