@@ -22,6 +22,7 @@
 #include "ademono/core/error.h"
 #include "ademono/depth/onnx_depth.h"
 #include "ademono/depth/sensor_depth.h"
+#include "ademono/detect/detection_io.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/detect/yolo_detector.h"
 #include "ademono/eval/trajectory_eval.h"
@@ -599,6 +600,23 @@ PYBIND11_MODULE(ademono, m) {
            "Boxes in image pixels, sorted by score")
       .def_property_readonly("name", &PyDetector::Name);
 
+  m.def(
+      "read_detections",
+      [](const fs::path& path) {
+        py::list out;
+        for (const FrameDetections& f : ReadDetectionsJsonl(path)) {
+          py::dict d;
+          d["frame"] = f.frame;
+          d["timestamp"] = f.timestamp;
+          d["name"] = f.name;
+          d["detections"] = f.detections;
+          out.append(d);
+        }
+        return out;
+      },
+      py::arg("path"),
+      "A detections cache (JSON lines, as `ademono infer` and `ademono synth` write): one dict "
+      "per frame with frame, timestamp, name and detections (list of Detection)");
   m.def(
       "read_trajectory",
       [](const fs::path& path, const std::string& format) {
