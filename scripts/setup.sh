@@ -27,6 +27,7 @@ apt_packages=(
   libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev
   libspdlog-dev libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
+  python3-dev pybind11-dev python3-matplotlib
 )
 missing=()
 for p in "${apt_packages[@]}"; do

@@ -1,8 +1,10 @@
-// `ademono eval`: scores an estimated trajectory against ground truth the way evo (APE/RPE) and
-// kitti-odom-eval (t_rel/r_rel) do. See docs/evaluation.md.
+// `ademono eval`: scores estimated trajectories against one ground truth the way evo (APE/RPE,
+// evo_res for several estimates) and kitti-odom-eval (t_rel/r_rel) do. See docs/evaluation.md.
+#include <algorithm>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
@@ -12,25 +14,112 @@
 
 namespace {
 
+const std::vector<std::string> kFormatNames = {"auto",  "tum",           "orbslam",
+                                               "kitti", "kitti-indexed", "euroc"};
+
 struct EvalArgs {
-  std::string gt, est, format = "tum", gt_format, est_format, align = "se3", rpe_unit = "frames",
-                       kitti_align;
+  std::string gt, format = "auto", gt_format, est_format, align = "se3", rpe_unit = "frames",
+                  kitti_align;
+  std::vector<std::string> est;
   double max_diff = 0.01, rpe_delta = 1;
   bool rpe_pairs_from_reference = false, kitti_metrics = false;
   std::string json, plot;
 };
 
+struct LoadedFile {
+  std::string path;
+  ademono::PoseSeries poses;
+  bool detected = false;
+};
+
+LoadedFile Load(const std::string& path, const std::string& format_name) {
+  using namespace ademono;
+  LoadedFile file;
+  file.path = path;
+  file.detected = format_name == "auto";
+  const TrajectoryFormat format =
+      file.detected ? DetectTrajectoryFormat(path) : ParseTrajectoryFormat(format_name);
+  file.poses = ReadPoseSeries(path, format);
+  return file;
+}
+
+std::string Describe(const LoadedFile& file) {
+  return file.path + " (" + ademono::ToString(file.poses.format) +
+         (file.detected ? ", detected" : ", as given") + ", " + std::to_string(file.poses.size()) +
+         " poses)";
+}
+
+ademono::EvalResult Evaluate(const LoadedFile& gt, const LoadedFile& est,
+                             ademono::EvalOptions options) {
+  using namespace ademono;
+  // Files without timestamps (KITTI) match by frame: pose i to pose i for plain files, by the
+  // written index as kitti-odom-eval does as soon as one file is indexed.
+  const bool gt_indexed = gt.poses.format == TrajectoryFormat::kKittiIndexed;
+  const bool est_indexed = est.poses.format == TrajectoryFormat::kKittiIndexed;
+  options.associate_by_timestamp = !gt.poses.HasFrameIndices() && !est.poses.HasFrameIndices();
+  options.associate_by_frame_index = gt_indexed || est_indexed;
+  if (options.associate_by_frame_index &&
+      !(gt.poses.HasFrameIndices() && est.poses.HasFrameIndices())) {
+    throw InputError(
+        "an indexed KITTI file matches poses by frame index and cannot be compared "
+        "with a timestamped file: " +
+        gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
+        ToString(est.poses.format) + ")");
+  }
+  try {
+    return EvaluateTrajectories(gt.poses, est.poses, options);
+  } catch (const std::invalid_argument& e) {
+    // The library does not know the files; name both here.
+    throw InputError(std::string(e.what()) + " between " + gt.path + " (" +
+                     std::to_string(gt.poses.size()) + " poses) and " + est.path + " (" +
+                     std::to_string(est.poses.size()) + " poses)");
+  }
+}
+
+// One row per estimate, evo_res style.
+std::string FormatTable(const std::vector<LoadedFile>& ests,
+                        const std::vector<ademono::EvalResult>& results) {
+  using namespace ademono;
+  size_t name_width = 8;
+  for (const auto& e : ests) name_width = std::max(name_width, e.path.size());
+  const bool kitti = results.front().kitti.has_value();
+  std::string out;
+  char buf[512];
+  std::snprintf(buf, sizeof(buf), "%-*s %7s %10s %10s %10s %10s %10s %12s %12s",
+                static_cast<int>(name_width), "estimate", "matched", "APE rmse", "APE mean",
+                "APE median", "APE max", "APE std", "RPE t rmse", "RPE r rmse");
+  out += buf;
+  if (kitti) {
+    std::snprintf(buf, sizeof(buf), " %9s %11s", "t_rel %", "r_rel d/100m");
+    out += buf;
+  }
+  out += "\n";
+  for (size_t k = 0; k < results.size(); ++k) {
+    const EvalResult& r = results[k];
+    std::snprintf(buf, sizeof(buf), "%-*s %7zu %10.6f %10.6f %10.6f %10.6f %10.6f %12.6f %12.6f",
+                  static_cast<int>(name_width), ests[k].path.c_str(), r.matched_poses, r.ape.rmse,
+                  r.ape.mean, r.ape.median, r.ape.max, r.ape.std, r.rpe_trans.rmse,
+                  r.rpe_rot_deg.rmse);
+    out += buf;
+    if (kitti) {
+      std::snprintf(buf, sizeof(buf), " %9.3f %11.3f", r.kitti->t_rel_percent,
+                    r.kitti->r_rel_deg_per_100m);
+      out += buf;
+    }
+    out += "\n";
+  }
+  std::snprintf(buf, sizeof(buf),
+                "(APE in m after %s alignment; RPE over %g %s, t in m, r in deg)\n",
+                ToString(results.front().alignment).c_str(), results.front().rpe_delta,
+                results.front().rpe_unit == DeltaUnit::kFrames ? "frames" : "m");
+  out += buf;
+  return out;
+}
+
 int RunEval(const EvalArgs& a) {
   using namespace ademono;
-  const TrajectoryFormat gt_format =
-      ParseTrajectoryFormat(a.gt_format.empty() ? a.format : a.gt_format);
-  const TrajectoryFormat est_format =
-      ParseTrajectoryFormat(a.est_format.empty() ? a.format : a.est_format);
   EvalOptions options;
   options.alignment = ParseAlignment(a.align);
-  // KITTI files carry no timestamps: match pose i to pose i as soon as one side is KITTI.
-  options.associate_by_timestamp =
-      gt_format != TrajectoryFormat::kKitti && est_format != TrajectoryFormat::kKitti;
   options.max_diff = a.max_diff;
   options.rpe_delta = a.rpe_delta;
   options.rpe_unit = ParseDeltaUnit(a.rpe_unit);
@@ -40,39 +129,74 @@ int RunEval(const EvalArgs& a) {
                                                   : ParseKittiAlignment(a.kitti_align);
   options.Check();
 
-  const PoseSeries gt = ReadPoseSeries(a.gt, gt_format);
-  const PoseSeries est = ReadPoseSeries(a.est, est_format);
-  EvalResult result;
-  try {
-    result = EvaluateTrajectories(gt, est, options);
-  } catch (const std::invalid_argument& e) {
-    // The library does not know the files; name both here.
-    throw InputError(std::string(e.what()) + " between " + a.gt + " (" + std::to_string(gt.size()) +
-                     " poses) and " + a.est + " (" + std::to_string(est.size()) + " poses)");
+  const LoadedFile gt = Load(a.gt, a.gt_format.empty() ? a.format : a.gt_format);
+  std::vector<LoadedFile> ests;
+  std::vector<EvalResult> results;
+  for (const std::string& path : a.est) {
+    ests.push_back(Load(path, a.est_format.empty() ? a.format : a.est_format));
+    results.push_back(Evaluate(gt, ests.back(), options));
   }
 
   // Render everything before writing anything, so a failure leaves no partial output.
-  const std::string json = a.json.empty() ? "" : ToJson(result).dump(2) + "\n";
-  const std::string svg = a.plot.empty() ? "" : RenderEvalSvg(result, a.est);
-  std::cout << FormatReport(result);
+  std::string json, svg;
+  if (!a.json.empty()) {
+    auto describe = [](const LoadedFile& f) {
+      return nlohmann::json{
+          {"file", f.path}, {"format", ToString(f.poses.format)}, {"format_detected", f.detected}};
+    };
+    nlohmann::json j;
+    if (results.size() == 1) {
+      j = ToJson(results.front());
+      j["gt_file"] = describe(gt);
+      j["est_file"] = describe(ests.front());
+    } else {
+      j["gt_file"] = describe(gt);
+      j["estimates"] = nlohmann::json::array();
+      for (size_t k = 0; k < results.size(); ++k) {
+        nlohmann::json e = ToJson(results[k]);
+        e["est_file"] = describe(ests[k]);
+        j["estimates"].push_back(e);
+      }
+    }
+    json = j.dump(2) + "\n";
+  }
+  if (!a.plot.empty()) {
+    std::vector<NamedEvalResult> named;
+    for (size_t k = 0; k < results.size(); ++k) named.push_back({ests[k].path, &results[k]});
+    svg = results.size() == 1 ? RenderEvalSvg(results.front(), a.est.front())
+                              : RenderEvalSvg(named, "ground truth " + a.gt);
+  }
+  std::cout << "ground truth: " << Describe(gt) << "\n";
+  for (const auto& e : ests) std::cout << "estimate: " << Describe(e) << "\n";
+  if (results.size() == 1) {
+    std::cout << FormatReport(results.front());
+  } else {
+    std::cout << FormatTable(ests, results);
+  }
   if (!a.json.empty()) WriteTextFileAtomic(a.json, json);
   if (!a.plot.empty()) WriteTextFileAtomic(a.plot, svg);
   return 0;
 }
 
 const bool kRegistered = ademono::cli::RegisterCommand(
-    "eval", "Score an estimated trajectory against ground truth (evo APE/RPE, KITTI t_rel/r_rel)",
+    "eval",
+    "Score estimated trajectories against ground truth (evo APE/RPE, KITTI t_rel/r_rel); "
+    "several --est give one table",
     [](CLI::App& app) -> ademono::cli::Runner {
       auto args = std::make_shared<EvalArgs>();
       app.add_option("--gt", args->gt, "Ground-truth trajectory file")->required();
-      app.add_option("--est", args->est, "Estimated trajectory file")->required();
-      app.add_option("--format", args->format, "File format of both files")
-          ->check(CLI::IsMember({"tum", "kitti", "euroc"}))
+      app.add_option("--est", args->est,
+                     "Estimated trajectory file; repeat to compare several in one table")
+          ->required()
+          ->take_all();
+      app.add_option("--format", args->format,
+                     "File format of all files (auto: detected from the first data line)")
+          ->check(CLI::IsMember(kFormatNames))
           ->capture_default_str();
       app.add_option("--gt-format", args->gt_format, "Format of --gt (default: --format)")
-          ->check(CLI::IsMember({"tum", "kitti", "euroc"}));
-      app.add_option("--est-format", args->est_format, "Format of --est (default: --format)")
-          ->check(CLI::IsMember({"tum", "kitti", "euroc"}));
+          ->check(CLI::IsMember(kFormatNames));
+      app.add_option("--est-format", args->est_format, "Format of every --est (default: --format)")
+          ->check(CLI::IsMember(kFormatNames));
       app.add_option("--align", args->align, "Alignment of the estimate before APE")
           ->check(CLI::IsMember({"none", "se3", "sim3", "origin"}))
           ->capture_default_str();

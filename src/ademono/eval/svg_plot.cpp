@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace ademono {
@@ -101,8 +102,18 @@ std::string Axes(const Mapper& m, const std::string& xlabel, const std::string& 
 }  // namespace
 
 std::string RenderEvalSvg(const EvalResult& r, const std::string& title) {
-  const auto& gt = r.gt_matched.world_from_cam;
-  const auto& est = r.est_aligned.world_from_cam;
+  return RenderEvalSvg(std::vector<NamedEvalResult>{{"estimate (aligned)", &r}}, title);
+}
+
+std::string RenderEvalSvg(const std::vector<NamedEvalResult>& results, const std::string& title) {
+  if (results.empty()) throw std::invalid_argument("RenderEvalSvg: no results");
+  // Matplotlib's tab10, without the grey used for the ground truth.
+  static constexpr const char* kColours[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
+                                             "#8c564b", "#e377c2", "#bcbd22", "#17becf"};
+  const EvalResult* longest = results.front().result;
+  for (const auto& named : results)
+    if (named.result->matched_poses > longest->matched_poses) longest = named.result;
+  const auto& gt = longest->gt_matched.world_from_cam;
   // The two axes of largest ground-truth extent, in axis order (x-z for a forward-moving camera).
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -118,7 +129,6 @@ std::string RenderEvalSvg(const EvalResult& r, const std::string& title) {
   const int ay = drop == 2 ? 1 : 2;
   const char* names = "xyz";
 
-  std::vector<std::array<double, 2>> gt_pts, est_pts;
   Box box{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
           -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   auto add = [&](std::vector<std::array<double, 2>>& pts, const Eigen::Matrix4d& p) {
@@ -126,21 +136,31 @@ std::string RenderEvalSvg(const EvalResult& r, const std::string& title) {
     pts.push_back({x, y});
     box = {std::min(box.x0, x), std::min(box.y0, y), std::max(box.x1, x), std::max(box.y1, y)};
   };
+  std::vector<std::array<double, 2>> gt_pts;
   for (const auto& p : gt) add(gt_pts, p);
-  for (const auto& p : est) add(est_pts, p);
+  std::vector<std::vector<std::array<double, 2>>> est_pts(results.size());
+  for (size_t k = 0; k < results.size(); ++k)
+    for (const auto& p : results[k].result->est_aligned.world_from_cam) add(est_pts[k], p);
   const double pad = 0.05 * std::max({box.x1 - box.x0, box.y1 - box.y0, 1e-6});
   box = {box.x0 - pad, box.y0 - pad, box.x1 + pad, box.y1 + pad};
   const Mapper top(box, kMargin, kMargin + 30, true);
 
-  // APE over time (seconds from the first matched pose).
-  std::vector<std::array<double, 2>> err_pts;
-  const double t0 = r.gt_matched.timestamps.empty() ? 0.0 : r.gt_matched.timestamps.front();
+  // APE over time (seconds from the first matched ground-truth pose of all estimates).
+  double t0 = std::numeric_limits<double>::infinity();
+  for (const auto& named : results)
+    if (!named.result->gt_matched.timestamps.empty())
+      t0 = std::min(t0, named.result->gt_matched.timestamps.front());
+  if (!std::isfinite(t0)) t0 = 0.0;
+  std::vector<std::vector<std::array<double, 2>>> err_pts(results.size());
   double t_max = 1e-9, e_max = 1e-9;
-  for (size_t i = 0; i < r.ape_errors.size(); ++i) {
-    const double t = r.gt_matched.timestamps[i] - t0;
-    err_pts.push_back({t, r.ape_errors[i]});
-    t_max = std::max(t_max, t);
-    e_max = std::max(e_max, r.ape_errors[i]);
+  for (size_t k = 0; k < results.size(); ++k) {
+    const EvalResult& r = *results[k].result;
+    for (size_t i = 0; i < r.ape_errors.size(); ++i) {
+      const double t = r.gt_matched.timestamps[i] - t0;
+      err_pts[k].push_back({t, r.ape_errors[i]});
+      t_max = std::max(t_max, t);
+      e_max = std::max(e_max, r.ape_errors[i]);
+    }
   }
   const Mapper err(Box{0, 0, t_max, e_max * 1.05}, 2 * kMargin + kPanel + 40, kMargin + 30, false);
 
@@ -152,19 +172,36 @@ std::string RenderEvalSvg(const EvalResult& r, const std::string& title) {
        "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   char header[256];
-  std::snprintf(header, sizeof(header), " (alignment %s, %zu poses, APE rmse %.4f m)",
-                ToString(r.alignment).c_str(), r.matched_poses, r.ape.rmse);
+  if (results.size() == 1) {
+    const EvalResult& r = *results.front().result;
+    std::snprintf(header, sizeof(header), " (alignment %s, %zu poses, APE rmse %.4f m)",
+                  ToString(r.alignment).c_str(), r.matched_poses, r.ape.rmse);
+  } else {
+    std::snprintf(header, sizeof(header), " (%zu estimates, alignment %s)", results.size(),
+                  ToString(results.front().result->alignment).c_str());
+  }
   s += "<text x=\"" + Num(kMargin) + "\" y=\"24\" font-size=\"15\">" + Escape(title + header) +
        "</text>\n";
   s += Axes(top, std::string(1, names[ax]) + " (m)", std::string(1, names[ay]) + " (m)");
   s += Polyline(gt_pts, top, "#555555", 1.5);
-  s += Polyline(est_pts, top, "#d62728", 1.2);
   s += "<text x=\"" + Num(top.ox + 8) + "\" y=\"" + Num(top.oy + 16) +
        "\" fill=\"#555555\">ground truth</text>\n";
-  s += "<text x=\"" + Num(top.ox + 8) + "\" y=\"" + Num(top.oy + 32) +
-       "\" fill=\"#d62728\">estimate (aligned)</text>\n";
   s += Axes(err, "time (s)", "APE (m)");
-  s += Polyline(err_pts, err, "#1f77b4", 1.2);
+  const size_t palette = sizeof(kColours) / sizeof(kColours[0]);
+  for (size_t k = 0; k < results.size(); ++k) {
+    const char* colour = kColours[k % palette];
+    s += Polyline(est_pts[k], top, colour, 1.2);
+    std::string label = results[k].name;
+    if (results.size() > 1) {
+      char rmse[64];
+      std::snprintf(rmse, sizeof(rmse), " (APE rmse %.4f m)", results[k].result->ape.rmse);
+      label += rmse;
+    }
+    s += "<text x=\"" + Num(top.ox + 8) + "\" y=\"" +
+         Num(top.oy + 32 + 16 * static_cast<double>(k)) + "\" fill=\"" + colour + "\">" +
+         Escape(label) + "</text>\n";
+    s += Polyline(err_pts[k], err, results.size() == 1 ? "#1f77b4" : colour, 1.2);
+  }
   s += "</svg>\n";
   return s;
 }

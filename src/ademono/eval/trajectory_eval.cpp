@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 
@@ -91,21 +92,21 @@ PoseSeries ToPoseSeries(const Trajectory& trajectory) {
 }
 
 PoseSeries ReadPoseSeries(const fs::path& path, TrajectoryFormat format) {
-  if (format != TrajectoryFormat::kKitti) return ToPoseSeries(ReadTrajectory(path, format));
+  if (format != TrajectoryFormat::kKitti && format != TrajectoryFormat::kKittiIndexed) {
+    PoseSeries series = ToPoseSeries(ReadTrajectory(path, format));
+    series.format = format;
+    return series;
+  }
+  const KittiRows rows =
+      ReadKittiRows(path, /*accept_index=*/true, format == TrajectoryFormat::kKittiIndexed);
   PoseSeries series;
-  ForEachDataLine(path, false, [&](size_t line, const std::vector<std::string_view>& f) {
-    if (f.size() != 12) {
-      ThrowInputError(path, line, "expected 12 fields, found " + std::to_string(f.size()));
-    }
+  series.format = rows.indexed ? TrajectoryFormat::kKittiIndexed : TrajectoryFormat::kKitti;
+  for (size_t i = 0; i < rows.rows.size(); ++i) {
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-    for (size_t i = 0; i < 12; ++i) m(i / 4, i % 4) = ParseDouble(f[i], path, line, i);
-    if (std::abs(m.topLeftCorner<3, 3>().determinant()) < 1e-6) {
-      ThrowInputError(path, line, "rotation part is singular");
-    }
-    series.timestamps.push_back(static_cast<double>(series.size()));
+    m.topRows<3>() = rows.rows[i];
+    series.timestamps.push_back(static_cast<double>(rows.index[i]));
     series.world_from_cam.push_back(m);
-  });
-  if (series.size() == 0) ThrowInputError(path, "trajectory file has no poses");
+  }
   return series;
 }
 
@@ -276,27 +277,63 @@ KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
                                           std::vector<Eigen::Matrix4d> est,
                                           KittiAlignment alignment) {
   if (gt.size() != est.size()) throw std::invalid_argument("KITTI evaluation needs equal sizes");
-  if (gt.empty()) throw std::invalid_argument("KITTI evaluation needs poses");
-  const size_t n = gt.size();
-  // Both trajectories start at the identity.
-  const Eigen::Matrix4d est0_inv = est[0].inverse();
-  const Eigen::Matrix4d gt0_inv = gt[0].inverse();
+  std::vector<int64_t> index(gt.size());
+  std::iota(index.begin(), index.end(), int64_t{0});
+  return EvaluateKittiOdometry(index, std::move(gt), index, std::move(est), alignment);
+}
+
+KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
+                                          std::vector<Eigen::Matrix4d> gt,
+                                          const std::vector<int64_t>& est_index,
+                                          std::vector<Eigen::Matrix4d> est,
+                                          KittiAlignment alignment) {
+  if (gt.empty() || est.empty()) throw std::invalid_argument("KITTI evaluation needs poses");
+  if (gt_index.size() != gt.size() || est_index.size() != est.size()) {
+    throw std::invalid_argument("KITTI evaluation: one index per pose");
+  }
+  const size_t n = gt.size(), m = est.size();
   for (size_t i = 0; i < n; ++i) {
-    est[i] = est0_inv * est[i];
-    gt[i] = gt0_inv * gt[i];
+    if (gt_index[i] != static_cast<int64_t>(i)) {
+      throw std::invalid_argument(
+          "KITTI metrics need ground-truth frame indices 0, 1, 2, ... without gaps");
+    }
+  }
+  // Position in `est` of each ground-truth frame, or m when that frame was not estimated.
+  std::vector<size_t> est_at(n, m);
+  for (size_t j = 0; j < m; ++j) {
+    if (est_index[j] < 0 || est_index[j] >= static_cast<int64_t>(n)) {
+      throw std::invalid_argument("estimate frame index " + std::to_string(est_index[j]) +
+                                  " has no ground-truth pose");
+    }
+    if (j > 0 && est_index[j] <= est_index[j - 1]) {
+      throw std::invalid_argument("estimate frame indices must increase");
+    }
+    est_at[static_cast<size_t>(est_index[j])] = j;
+  }
+  auto gt_of = [&](size_t j) -> Eigen::Matrix4d& { return gt[static_cast<size_t>(est_index[j])]; };
+  // Both trajectories start at the identity; kitti-odom-eval moves only the ground-truth poses
+  // that have an estimate.
+  const Eigen::Matrix4d est0_inv = est[0].inverse();
+  const Eigen::Matrix4d gt0_inv = gt_of(0).inverse();
+  for (size_t j = 0; j < m; ++j) {
+    est[j] = est0_inv * est[j];
+    gt_of(j) = gt0_inv * gt_of(j);
   }
   if (alignment == KittiAlignment::kScale) {
     double xy = 0, xx = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d x = est[i].topRightCorner<3, 1>();
-      xy += x.dot(gt[i].topRightCorner<3, 1>());
+    for (size_t j = 0; j < m; ++j) {
+      const Eigen::Vector3d x = est[j].topRightCorner<3, 1>();
+      xy += x.dot(gt_of(j).topRightCorner<3, 1>());
       xx += x.squaredNorm();
     }
     const double scale = xy / xx;
     for (auto& pose : est) pose.topRightCorner<3, 1>() *= scale;
   } else if (alignment != KittiAlignment::kNone) {
+    Eigen::Matrix3Xd gt_xyz(3, static_cast<Eigen::Index>(m));
+    for (size_t j = 0; j < m; ++j)
+      gt_xyz.col(static_cast<Eigen::Index>(j)) = gt_of(j).topRightCorner<3, 1>();
     const Similarity sim =
-        UmeyamaAlignment(Positions(est), Positions(gt), alignment == KittiAlignment::kSevenDof);
+        UmeyamaAlignment(Positions(est), gt_xyz, alignment == KittiAlignment::kSevenDof);
     Eigen::Matrix4d align = Eigen::Matrix4d::Identity();
     align.topLeftCorner<3, 3>() = sim.rotation;
     align.topRightCorner<3, 1>() = sim.translation;
@@ -306,7 +343,7 @@ KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
     }
   }
 
-  // Sub-sequence errors (calc_sequence_errors).
+  // Sub-sequence errors (calc_sequence_errors), path length along the whole ground truth.
   std::vector<double> dist(n, 0.0);
   for (size_t i = 1; i < n; ++i) {
     dist[i] =
@@ -325,9 +362,9 @@ KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
           break;
         }
       }
-      if (last == n) continue;
+      if (last == n || est_at[first] == m || est_at[last] == m) continue;
       const Eigen::Matrix4d delta_gt = gt[first].inverse() * gt[last];
-      const Eigen::Matrix4d delta_est = est[first].inverse() * est[last];
+      const Eigen::Matrix4d delta_est = est[est_at[first]].inverse() * est[est_at[last]];
       const Eigen::Matrix4d error = delta_est.inverse() * delta_gt;
       r_sum += KittiRotationError(error) / length;
       t_sum += KittiTranslationError(error) / length;
@@ -340,23 +377,26 @@ KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
     result.t_rel_percent = t_sum / static_cast<double>(segments) * 100.0;
     result.r_rel_deg_per_100m = r_sum / static_cast<double>(segments) * kRadToDeg * 100.0;
   }
-  // compute_ATE and compute_RPE.
+  // compute_ATE and compute_RPE, over the estimated frames.
   double ate_sq = 0;
-  for (size_t i = 0; i < n; ++i) {
-    ate_sq += (gt[i].topRightCorner<3, 1>() - est[i].topRightCorner<3, 1>()).squaredNorm();
+  for (size_t j = 0; j < m; ++j) {
+    ate_sq += (gt_of(j).topRightCorner<3, 1>() - est[j].topRightCorner<3, 1>()).squaredNorm();
   }
-  result.ate_m = std::sqrt(ate_sq / static_cast<double>(n));
-  if (n > 1) {
-    double rpe_t = 0, rpe_r = 0;
-    for (size_t i = 0; i + 1 < n; ++i) {
-      const Eigen::Matrix4d gt_rel = gt[i].inverse() * gt[i + 1];
-      const Eigen::Matrix4d est_rel = est[i].inverse() * est[i + 1];
-      const Eigen::Matrix4d error = gt_rel.inverse() * est_rel;
-      rpe_t += KittiTranslationError(error);
-      rpe_r += KittiRotationError(error);
-    }
-    result.rpe_m = rpe_t / static_cast<double>(n - 1);
-    result.rpe_deg = rpe_r / static_cast<double>(n - 1) * kRadToDeg;
+  result.ate_m = std::sqrt(ate_sq / static_cast<double>(m));
+  double rpe_t = 0, rpe_r = 0;
+  size_t rpe_pairs = 0;
+  for (size_t j = 0; j + 1 < m; ++j) {
+    if (est_index[j + 1] != est_index[j] + 1) continue;
+    const Eigen::Matrix4d gt_rel = gt_of(j).inverse() * gt_of(j + 1);
+    const Eigen::Matrix4d est_rel = est[j].inverse() * est[j + 1];
+    const Eigen::Matrix4d error = gt_rel.inverse() * est_rel;
+    rpe_t += KittiTranslationError(error);
+    rpe_r += KittiRotationError(error);
+    ++rpe_pairs;
+  }
+  if (rpe_pairs > 0) {
+    result.rpe_m = rpe_t / static_cast<double>(rpe_pairs);
+    result.rpe_deg = rpe_r / static_cast<double>(rpe_pairs) * kRadToDeg;
   }
   return result;
 }
@@ -379,6 +419,21 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
       char buf[64];
       std::snprintf(buf, sizeof(buf), "%g", options.max_diff);
       throw std::invalid_argument(std::string("no matching timestamps within ") + buf + " s");
+    }
+  } else if (options.associate_by_frame_index) {
+    // kitti-odom-eval: poses keyed by frame index, the estimate's keys looked up in the ground
+    // truth.
+    std::map<double, size_t> gt_at;
+    for (size_t i = 0; i < gt.size(); ++i) gt_at.emplace(gt.timestamps[i], i);
+    for (size_t j = 0; j < est.size(); ++j) {
+      const auto it = gt_at.find(est.timestamps[j]);
+      if (it == gt_at.end()) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%.0f", est.timestamps[j]);
+        throw std::invalid_argument(std::string("estimate frame index ") + buf +
+                                    " has no ground-truth pose");
+      }
+      pairs.emplace_back(it->second, j);
     }
   } else {
     if (gt.size() != est.size()) {
@@ -439,7 +494,15 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
 
   if (options.kitti_metrics) {
     r.kitti_alignment = options.kitti_alignment;
-    r.kitti = EvaluateKittiOdometry(gt_poses, est_unaligned, options.kitti_alignment);
+    if (options.associate_by_frame_index && !options.associate_by_timestamp) {
+      std::vector<int64_t> gt_index, est_index;
+      for (double t : gt.timestamps) gt_index.push_back(std::llround(t));
+      for (double t : est.timestamps) est_index.push_back(std::llround(t));
+      r.kitti = EvaluateKittiOdometry(gt_index, gt.world_from_cam, est_index, est.world_from_cam,
+                                      options.kitti_alignment);
+    } else {
+      r.kitti = EvaluateKittiOdometry(gt_poses, est_unaligned, options.kitti_alignment);
+    }
   }
   return r;
 }

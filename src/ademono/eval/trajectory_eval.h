@@ -13,6 +13,7 @@
 // matrix inverse and measures rotation by arccos((trace - 1) / 2).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -23,15 +24,22 @@
 
 namespace ademono {
 
-// Timestamped raw poses. For KITTI files timestamps are the line indices 0, 1, 2, ...
+// Timestamped raw poses. For KITTI files timestamps are the frame indices: the line indices
+// 0, 1, 2, ... of a plain file, the indices written in an indexed one (sorted, may skip).
 struct PoseSeries {
   std::vector<double> timestamps;
   std::vector<Eigen::Matrix4d> world_from_cam;
+  // The format actually read: kKitti becomes kKittiIndexed when the file carries indices.
+  TrajectoryFormat format = TrajectoryFormat::kTum;
   size_t size() const { return world_from_cam.size(); }
+  bool HasFrameIndices() const {
+    return format == TrajectoryFormat::kKitti || format == TrajectoryFormat::kKittiIndexed;
+  }
 };
 PoseSeries ToPoseSeries(const Trajectory& trajectory);
-// Reads a trajectory file without touching the rotation matrices (KITTI) or through the TUM /
-// EuRoC quaternion readers. Same errors as io/trajectory.h.
+// Reads a trajectory file without touching the rotation matrices (KITTI, plain or indexed, as
+// kitti-odom-eval's loader: "kitti" takes either) or through the TUM / EuRoC quaternion readers.
+// Same errors as io/trajectory.h.
 PoseSeries ReadPoseSeries(const std::filesystem::path& path, TrajectoryFormat format);
 
 // Population statistics (numpy: np.std with ddof = 0, np.median averaging the middle pair).
@@ -77,6 +85,10 @@ struct EvalOptions {
   Alignment alignment = Alignment::kSe3;
   // Match poses by timestamp (TUM, EuRoC) or pose i to pose i (KITTI: sizes must be equal).
   bool associate_by_timestamp = true;
+  // Without timestamps: match by frame index as kitti-odom-eval does (for indexed KITTI files,
+  // whose indices may skip): every estimate index must exist in the ground truth, ground-truth
+  // poses without an estimate are left out. The timestamps of both series are the indices.
+  bool associate_by_frame_index = false;
   double max_diff = 0.01;  // seconds, evo's default for TUM
   double rpe_delta = 1.0;
   DeltaUnit rpe_unit = DeltaUnit::kFrames;
@@ -122,6 +134,18 @@ EvalResult EvaluateTrajectories(const Trajectory& gt, const Trajectory& est,
 
 // kitti-odom-eval on index-matched poses (gt[i] <-> est[i], equal sizes).
 KittiOdometryResult EvaluateKittiOdometry(std::vector<Eigen::Matrix4d> gt,
+                                          std::vector<Eigen::Matrix4d> est,
+                                          KittiAlignment alignment);
+// kitti-odom-eval on poses keyed by frame index, the estimate's indices possibly skipping.
+// `gt_index` must be 0, 1, ..., N-1 (kitti-odom-eval indexes its path distances by position and
+// looks poses up by key, which agree only then); `est_index` strictly increasing, each < N.
+// As kitti-odom-eval: only the ground-truth poses with an estimate are moved to the first
+// estimated frame; segments count only when both end frames were estimated; ATE over the
+// estimated frames. RPE uses the consecutive index pairs (i, i + 1) that were both estimated
+// (kitti-odom-eval itself stops with a KeyError when i + 1 is missing).
+KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
+                                          std::vector<Eigen::Matrix4d> gt,
+                                          const std::vector<int64_t>& est_index,
                                           std::vector<Eigen::Matrix4d> est,
                                           KittiAlignment alignment);
 
