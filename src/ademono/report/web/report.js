@@ -241,14 +241,20 @@
     const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
     for (const c of pathCols) for (let a = 0; a < 3; a++) for (const v of c[a]) { lo[a] = Math.min(lo[a], v); hi[a] = Math.max(hi[a], v); }
     if (cloud) {
-      for (let i = 0; i < cloud.xyz.length; i += 3) for (let a = 0; a < 3; a++) {
-        const v = cloud.xyz[i + a]; lo[a] = Math.min(lo[a], v); hi[a] = Math.max(hi[a], v);
+      // The map's 5th-95th percentile box, so a few far outliers do not shrink the view.
+      const n = cloud.xyz.length / 3;
+      for (let a = 0; a < 3; a++) {
+        const v = new Float32Array(n);
+        for (let i = 0; i < n; i++) v[i] = cloud.xyz[3 * i + a];
+        v.sort();
+        lo[a] = Math.min(lo[a], v[Math.floor(0.05 * (n - 1))]);
+        hi[a] = Math.max(hi[a], v[Math.ceil(0.95 * (n - 1))]);
       }
     }
     const center = [0, 1, 2].map((a) => (Number.isFinite(lo[a]) ? (lo[a] + hi[a]) / 2 : 0));
     const radius = Math.max(0.5, ...[0, 1, 2].map((a) => (Number.isFinite(lo[a]) ? hi[a] - lo[a] : 0)));
     const up = [0, 0, 0]; up[upAxis] = upAxis === 1 ? -1 : 1;  // y is down in camera-style worlds
-    const cam = { yaw: 0.8, pitch: 0.6, dist: radius * 1.4, target: center.slice() };
+    const cam = { yaw: 0.8, pitch: 0.5, dist: radius * 1.2, target: center.slice() };
 
     const vert = 'precision mediump float; attribute vec3 position; attribute vec3 color; uniform mat4 proj, view; uniform float size; varying vec3 vColor;' +
       'void main() { vColor = color; gl_Position = proj * view * vec4(position, 1.0); gl_PointSize = size; }';
@@ -285,9 +291,9 @@
       eye[a2] += cam.dist * Math.cos(cam.pitch) * Math.sin(cam.yaw);
       eye[upAxis] += up[upAxis] * cam.dist * Math.sin(cam.pitch);
       const props = { proj: perspective(Math.PI / 4, w / Math.max(1, h), radius * 0.01, radius * 20), view: lookAt(eye, cam.target, up) };
-      if (drawPoints) drawPoints(Object.assign({ size: 2 * dpr }, props));
+      if (drawPoints) drawPoints(Object.assign({ size: 3 * dpr }, props));
+      for (const d of drawMarks) d(Object.assign({ size: 4 * dpr }, props));
       for (const d of drawLines) d(Object.assign({ size: 1 }, props));
-      for (const d of drawMarks) d(Object.assign({ size: 5 * dpr }, props));
     }
     let drag = null;
     canvas.addEventListener('pointerdown', (e) => { drag = { x: e.clientX, y: e.clientY, pan: e.button !== 0 || e.shiftKey }; canvas.setPointerCapture(e.pointerId); });
@@ -517,14 +523,19 @@
   try {
     const D = JSON.parse(document.getElementById('report-data').textContent);
     if (D.kind === 'comparison') renderComparison(D); else renderRun(D);
-    // Where each plot and the 3D view landed (page pixels), for the browser test's pixel checks.
-    const layout = {};
-    for (const node of document.querySelectorAll('[id^="plot-"], #map3d')) {
-      const r = node.getBoundingClientRect();
-      layout[node.id] = [Math.round(r.left + scrollX), Math.round(r.top + scrollY), Math.round(r.width), Math.round(r.height)];
-    }
-    document.body.dataset.layout = JSON.stringify(layout);
-    document.body.dataset.ready = '1';
+    // Where each plot and the 3D view landed (page pixels), for the browser test's pixel checks;
+    // measured once the page has loaded and laid out.
+    const recordLayout = () => {
+      const layout = {};
+      for (const node of document.querySelectorAll('[id^="plot-"], #map3d')) {
+        const r = node.getBoundingClientRect();
+        layout[node.id] = [Math.round(r.left + scrollX), Math.round(r.top + scrollY), Math.round(r.width), Math.round(r.height)];
+      }
+      layout.page = [0, 0, document.documentElement.scrollWidth, document.documentElement.scrollHeight];
+      document.body.dataset.layout = JSON.stringify(layout);
+      document.body.dataset.ready = '1';
+    };
+    window.addEventListener('load', () => setTimeout(recordLayout, 100));
   } catch (e) {
     showError(String(e && e.stack ? e.stack : e));
     console.error(e);
