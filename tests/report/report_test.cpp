@@ -227,6 +227,28 @@ TEST_F(ReportTest, PerFrameSeriesAndCriticalPath) {
   EXPECT_DOUBLE_EQ(cp["worker_median_ms"].get<double>(), 6.0);
 }
 
+TEST_F(ReportTest, CriticalPathFromTheMediansWithoutPerFrameTimes) {
+  WriteRunFolder(root_ / "run");
+  json summary = json::parse(ReadTextFile(root_ / "run" / "summary.json"));
+  for (json& f : summary["per_frame"]) f.erase("ms");
+  summary["timing"] = {{"extraction", {{"median_ms", 8.0}, {"p95_ms", 9.0}}},
+                       {"depth", {{"median_ms", 40.0}, {"p95_ms", 50.0}}},
+                       {"detection", {{"median_ms", 15.0}, {"p95_ms", 16.0}}},
+                       {"filter", {{"median_ms", 1.0}, {"p95_ms", 2.0}}},
+                       {"tracking", {{"median_ms", 9.0}, {"p95_ms", 12.0}}},
+                       {"local_mapping", {{"median_ms", 2.0}, {"p95_ms", 200.0}}}};
+  WriteTextFileAtomic(root_ / "run" / "summary.json", summary.dump());
+  const json data = RunReportData(ReadRunFolder(root_ / "run"), ReportOptions());
+  EXPECT_TRUE(data["frames"]["ms"].empty());
+  const json& cp = data["critical_path"];
+  // Worker 40 + 15 = 55 ms against main 8 + 1 + 9 + 2 = 20 ms: depth dominates.
+  EXPECT_EQ(cp["from_medians"], true);
+  EXPECT_EQ(cp["critical_branch"], "worker");
+  EXPECT_EQ(cp["dominant_stage"], "depth");
+  EXPECT_DOUBLE_EQ(cp["main_median_ms"].get<double>(), 20.0);
+  EXPECT_DOUBLE_EQ(cp["worker_median_ms"].get<double>(), 55.0);
+}
+
 TEST_F(ReportTest, SubsamplesTheMapBeyondTheCap) {
   WriteRunFolder(root_ / "run");
   ReportOptions options;

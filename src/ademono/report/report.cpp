@@ -255,12 +255,45 @@ json FramesJson(const RunFolder& run, double t0) {
   return cols;
 }
 
-json CriticalPathJson(const json& frames) {
+// Without per-frame times, the same analysis on summary.json's per-stage medians ("timing",
+// where mapping is called local_mapping).
+json CriticalPathFromMedians(const json& timing) {
+  if (!timing.is_object() || timing.empty()) return nullptr;
+  auto median = [&](const std::string& stage) {
+    const std::string key = stage == "mapping" ? "local_mapping" : stage;
+    return timing.contains(key) ? timing[key].value("median_ms", 0.0) : 0.0;
+  };
+  json stages = json::array();
+  double main = 0, worker = 0;
+  for (const auto& s : kMainStages) {
+    main += median(s);
+    stages.push_back({{"stage", s}, {"branch", "main"}, {"median_ms", median(s)}});
+  }
+  for (const auto& s : kWorkerStages) {
+    worker += median(s);
+    stages.push_back({{"stage", s}, {"branch", "worker"}, {"median_ms", median(s)}});
+  }
+  const bool main_critical = main >= worker;
+  std::string dominant;
+  double dominant_ms = -1;
+  for (const json& s : stages) {
+    if ((s["branch"] == "main") == main_critical && s["median_ms"].get<double>() > dominant_ms) {
+      dominant_ms = s["median_ms"].get<double>();
+      dominant = s["stage"].get<std::string>();
+    }
+  }
+  return {{"stages", stages},         {"main_median_ms", main},
+          {"worker_median_ms", worker}, {"frame_median_ms", std::max(main, worker)},
+          {"from_medians", true},       {"critical_branch", main_critical ? "main" : "worker"},
+          {"dominant_stage", dominant}, {"dominant_median_ms", dominant_ms}};
+}
+
+json CriticalPathJson(const json& frames, const json& summary) {
   const json& ms = frames.at("ms");
   json out;
   json stages = json::array();
   const size_t n = frames.at("frame").size();
-  if (n == 0 || ms.empty()) return nullptr;
+  if (n == 0 || ms.empty()) return CriticalPathFromMedians(summary.value("timing", json()));
   auto column = [&](const std::string& name) {
     std::vector<double> v(n, 0.0);
     if (ms.contains(name))
@@ -611,7 +644,7 @@ json RunReportData(const RunFolder& run, const ReportOptions& options) {
   data["t0"] = t0;
   data["frames"] = FramesJson(run, t0);
   data["traj"] = TrajectoryJson(run, aligned, t0);
-  data["critical_path"] = CriticalPathJson(data["frames"]);
+  data["critical_path"] = CriticalPathJson(data["frames"], run.summary);
   data["map"] = MapJson(run, aligned, options);
   std::string thumbs_note;
   data["thumbs"] = ThumbnailsJson(run, data["frames"], data["traj"], options, &thumbs_note);

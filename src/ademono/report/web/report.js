@@ -179,7 +179,7 @@
     if (!(x1 > x0)) { x0 -= 0.5; x1 += 0.5; }
     if (!(y1 > y0)) { y0 -= 0.5; y1 += 0.5; }
     // Equal metres per pixel on both axes (the plot area is about width-70 by height-60 px).
-    const height = 360, width = plotWidth(container);
+    const height = 440, width = plotWidth(container);
     const pw = Math.max(100, width - 70), ph = height - 60;
     const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
     const mpp = Math.max((x1 - x0) / pw, (y1 - y0) / ph) * 1.08;
@@ -346,14 +346,14 @@
     if (D.alignment_note) trajPanel.appendChild(note(D.alignment_note));
     else trajPanel.appendChild(el('div', { class: 'hint' }, 'Estimate aligned to the ground truth with ' + D.alignment +
       (T.scale !== undefined ? ' (scale ' + fmt(T.scale, 4) + ')' : '') + '; ATE RMSE over ' + T.err.length + ' poses: ' + fmt(T.ate.rmse, 4) + ' m.'));
+    // Top view on the left, each axis over time on the right.
     const top = el('div', { id: 'plot-top' });
-    trajPanel.appendChild(top);
+    const axesBox = el('div', { id: 'plot-axes' });
+    trajPanel.appendChild(el('div', { class: 'grid2' }, top, axesBox));
     const paths = [];
     if (T.gt) paths.push({ label: 'ground truth', xyz: T.gt, color: COLORS.gt, width: 2 });
     paths.push({ label: 'estimate', xyz: T.est, color: COLORS.est, width: 2 });
     topViewPlot(top, paths);
-    const axesBox = el('div', { id: 'plot-axes' });
-    trajPanel.appendChild(axesBox);
     for (let a = 0; a < 3; a++) {
       const name = 'xyz'[a];
       const box = el('div', {});
@@ -369,7 +369,9 @@
       } else {
         data = [T.t, T.est[a]];
       }
-      makePlot(box, 170, timeOpts(name + ' over time', name + ' (m)', series, F, false), data);
+      const opts = timeOpts(name + ' over time', name + ' (m)', series, F, false);
+      opts.legend = { show: false };  // same two series as the top view's legend
+      makePlot(box, 150, opts, data);
     }
 
     // Error over time.
@@ -402,12 +404,15 @@
         fmt(F.state.filter((s) => s === 2).length, 0) + ' lost frames')));
     const tl = el('div', { id: 'plot-timeline' });
     tlPanel.appendChild(tl);
-    makePlot(tl, 200, timeOpts('Inliers and features per frame', 'points', [
-      { label: 'keypoints', stroke: '#adb5bd', width: 1 },
-      { label: 'kept by the filters', stroke: '#37b24d', width: 1 },
-      { label: 'with depth', stroke: '#9775fa', width: 1 },
-      { label: 'inliers', stroke: COLORS.inliers, width: 1.5 },
-    ], F, true), [F.t, F.keypoints, F.kept, F.with_depth, F.inliers]);
+    // Negative counts mean "not recorded": such series are left out.
+    const counts = [
+      [F.keypoints, { label: 'keypoints', stroke: '#adb5bd', width: 1 }],
+      [F.kept, { label: 'kept by the filters', stroke: '#37b24d', width: 1 }],
+      [F.with_depth, { label: 'with depth', stroke: '#9775fa', width: 1 }],
+      [F.inliers, { label: 'inliers', stroke: COLORS.inliers, width: 1.5 }],
+    ].filter(([v]) => v.some((x) => x >= 0));
+    makePlot(tl, 200, timeOpts('Features and inliers per frame', 'points', counts.map(([, s]) => s), F, true),
+      [F.t].concat(counts.map(([v]) => v)));
 
     // Timing and critical path.
     const timePanel = panel('Time per frame');
@@ -427,8 +432,10 @@
       const rows = C.stages.map((s) => el('tr', { class: s.stage === C.dominant_stage ? 'crit' : '' },
         el('td', {}, s.stage), el('td', {}, s.branch === 'main' ? 'main thread' : 'prefetch worker'), el('td', {}, fmt(s.median_ms, 2)),
         el('td', { style: 'text-align:left' }, el('span', { class: 'bar', style: 'width:' + Math.round(160 * s.median_ms / maxMs) + 'px;background:' + (STAGE_COLORS[s.stage] || '#adb5bd') }))));
+      const bound = C.from_medians ? ' is the longer branch (from the per-stage medians in summary.json); median ' :
+        ' bounds ' + (C.critical_branch === 'main' ? C.main_bound_frames : C.frames - C.main_bound_frames) + ' of ' + C.frames + ' frames; median ';
       timePanel.appendChild(el('p', {}, 'Critical path: the ' + (C.critical_branch === 'main' ? 'main thread (extraction → filter → tracking → mapping)' : 'prefetch worker (depth + detection)') +
-        ' bounds ' + (C.critical_branch === 'main' ? C.main_bound_frames : C.frames - C.main_bound_frames) + ' of ' + C.frames + ' frames; median ' +
+        bound +
         fmt(C.main_median_ms, 1) + ' ms on the main thread vs ' + fmt(C.worker_median_ms, 1) + ' ms on the worker, which runs one frame ahead. ' +
         'Dominant stage: ', el('b', {}, C.dominant_stage), ' (median ' + fmt(C.dominant_median_ms, 1) + ' ms).'));
       timePanel.appendChild(el('table', {}, el('tr', {}, el('th', {}, 'stage'), el('th', {}, 'runs on'), el('th', {}, 'median ms'), el('th', {}, '')), ...rows));
@@ -531,7 +538,8 @@
         const r = node.getBoundingClientRect();
         layout[node.id] = [Math.round(r.left + scrollX), Math.round(r.top + scrollY), Math.round(r.width), Math.round(r.height)];
       }
-      layout.page = [0, 0, document.documentElement.scrollWidth, document.documentElement.scrollHeight];
+      const app = document.getElementById('app').getBoundingClientRect();
+      layout.page = [0, 0, Math.round(app.right), Math.ceil(app.bottom + scrollY)];
       document.body.dataset.layout = JSON.stringify(layout);
       document.body.dataset.ready = '1';
     };
