@@ -298,7 +298,7 @@ TEST_F(ReportTest, PageInlinesTheLibrariesAndKeepsTheDataInsideItsScript) {
   const std::string html = ReadTextFile(out);
   EXPECT_NE(html.find("uPlot"), std::string::npos);
   EXPECT_NE(html.find("createREGL"), std::string::npos);
-  EXPECT_NE(html.find("folder:<\\/script><b>x"), std::string::npos);
+  EXPECT_NE(html.find("folder:\\u003c/script>\\u003cb>x"), std::string::npos);
   EXPECT_EQ(html.find("folder:</script>"), std::string::npos);
   // Nothing fetched at view time.
   EXPECT_EQ(html.find("src=\"http"), std::string::npos);

@@ -444,16 +444,16 @@ double FirstTimestamp(const RunFolder& run) {
   return run.trajectory.empty() ? 0.0 : run.trajectory.front().timestamp;
 }
 
-std::string ScriptSafe(std::string text) {
-  // JSON inside <script>: "</" would end the element early.
+// JSON inside <script>: "</script" or "<!--" would end or change the element early; '<' only
+// occurs inside JSON strings, where "\u003c" means the same.
+std::string ScriptSafe(const std::string& text) {
   std::string out;
   out.reserve(text.size());
-  for (size_t i = 0; i < text.size(); ++i) {
-    if (text[i] == '<' && i + 1 < text.size() && text[i + 1] == '/') {
-      out += "<\\/";
-      ++i;
+  for (char c : text) {
+    if (c == '<') {
+      out += "\\u003c";
     } else {
-      out += text[i];
+      out += c;
     }
   }
   return out;
