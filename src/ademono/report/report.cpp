@@ -129,6 +129,15 @@ json TrajectoryJson(const RunFolder& run, const AlignedRun& aligned, double t0) 
   }
   traj["t"] = std::move(t);
   traj["est"] = XyzColumns(est);
+  // Mean optical axis (camera z in the aligned world), so the 3D view starts looking the way the
+  // camera looked.
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  for (const StampedPose& p : run.trajectory)
+    axis += aligned.gt_from_est.rotation * p.world_from_cam.linear().col(2);
+  if (axis.norm() > 1e-9) {
+    axis.normalize();
+    traj["view_dir"] = {axis.x(), axis.y(), axis.z()};
+  }
   if (aligned.eval) {
     const EvalResult& e = *aligned.eval;
     std::vector<Eigen::Vector3d> gt;

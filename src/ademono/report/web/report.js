@@ -227,7 +227,7 @@
     for (let i = 0; i < n; i++) { out[3 * i] = cols[0][i]; out[3 * i + 1] = cols[1][i]; out[3 * i + 2] = cols[2][i]; }
     return out;
   }
-  function mapView(container, map, lines, pointsExtra) {
+  function mapView(container, map, lines, pointsExtra, viewDir) {
     const canvas = el('canvas', { id: 'map3d' });
     container.appendChild(canvas);
     const dpr = window.devicePixelRatio || 1;
@@ -254,7 +254,15 @@
     const center = [0, 1, 2].map((a) => (Number.isFinite(lo[a]) ? (lo[a] + hi[a]) / 2 : 0));
     const radius = Math.max(0.5, ...[0, 1, 2].map((a) => (Number.isFinite(lo[a]) ? hi[a] - lo[a] : 0)));
     const up = [0, 0, 0]; up[upAxis] = upAxis === 1 ? -1 : 1;  // y is down in camera-style worlds
+    // Sparse maps get bigger dots, dense ones smaller so they do not turn into a blob.
+    const pointSize = !cloud ? 1 : cloud.xyz.length / 3 < 5000 ? 4 : cloud.xyz.length / 3 < 30000 ? 3 : 2;
     const cam = { yaw: 0.8, pitch: 0.5, dist: radius * 1.2, target: center.slice() };
+    if (viewDir) {
+      // Start behind the cameras, looking where they looked, a little from above.
+      const a1 = (upAxis + 1) % 3, a2 = (upAxis + 2) % 3;
+      cam.yaw = Math.atan2(-viewDir[a2], -viewDir[a1]);
+      cam.pitch = Math.max(-1.2, Math.min(1.2, Math.asin(Math.max(-1, Math.min(1, -viewDir[upAxis] * up[upAxis]))) + 0.45));
+    }
 
     const vert = 'precision mediump float; attribute vec3 position; attribute vec3 color; uniform mat4 proj, view; uniform float size; varying vec3 vColor;' +
       'void main() { vColor = color; gl_Position = proj * view * vec4(position, 1.0); gl_PointSize = size; }';
@@ -275,6 +283,7 @@
     }));
     const drawMarks = (pointsExtra || []).filter((p) => p.xyz[0].length > 0).map((p) => regl({
       vert: lineVert, frag: lineFrag, primitive: 'points', count: p.xyz[0].length,
+      depth: { enable: false },  // poses stay visible over the map, later marks (keyframes) on top
       attributes: { position: regl.buffer(interleave(p.xyz)) },
       uniforms: Object.assign({ color: hexColor(p.color) }, uniforms),
     }));
@@ -291,7 +300,7 @@
       eye[a2] += cam.dist * Math.cos(cam.pitch) * Math.sin(cam.yaw);
       eye[upAxis] += up[upAxis] * cam.dist * Math.sin(cam.pitch);
       const props = { proj: perspective(Math.PI / 4, w / Math.max(1, h), radius * 0.01, radius * 20), view: lookAt(eye, cam.target, up) };
-      if (drawPoints) drawPoints(Object.assign({ size: 3 * dpr }, props));
+      if (drawPoints) drawPoints(Object.assign({ size: pointSize * dpr }, props));
       for (const d of drawMarks) d(Object.assign({ size: 4 * dpr }, props));
       for (const d of drawLines) d(Object.assign({ size: 1 }, props));
     }
@@ -464,7 +473,11 @@
     const lines = [];
     if (T.gt) lines.push({ xyz: T.gt, color: '#ced4da' });
     lines.push({ xyz: T.est, color: COLORS.est });
-    mapView(mapPanel, M, lines, [{ xyz: T.kf, color: '#4dabf7' }]);
+    // Poses as dots as well: WebGL draws lines 1 px wide only.
+    const marks = [];
+    if (T.gt) marks.push({ xyz: T.gt, color: '#ced4da' });
+    marks.push({ xyz: T.est, color: COLORS.est }, { xyz: T.kf, color: '#4dabf7' });
+    mapView(mapPanel, M, lines, marks, T.view_dir);
 
     // Thumbnails.
     const thPanel = panel('Frames that matter');
@@ -485,17 +498,22 @@
     app.appendChild(el('h1', {}, 'ademono comparison: ' + V.length + ' runs'));
     app.appendChild(el('div', { class: 'sub' }, 'dataset ' + (V[0].summary.dataset || '?') + ' · each estimate aligned to its ground truth with ' + D.alignment));
     const filterKeys = FILTER_SERIES.map(([k]) => k).filter((k) => V.some((v) => v.summary.filter_counts && v.summary.filter_counts[k] !== undefined));
-    const head = el('tr', {}, el('th', {}, 'run'), el('th', {}, 'tracked'), el('th', {}, 'lost'), el('th', {}, 'keyframes'), el('th', {}, 'map points'),
-      el('th', {}, 'ATE (' + D.alignment + ') m'), el('th', {}, 'ATE se3 m'), el('th', {}, 'ATE sim3 m'), ...filterKeys.map((k) => el('th', {}, k.replace('removed_', '−'))));
+    const filterLabel = Object.fromEntries(FILTER_SERIES.map(([k, label]) => [k, k === 'kept' ? 'kept' : '− ' + label]));
+    const head = el('tr', {}, el('th', {}, 'run'), el('th', {}, 'filters'), el('th', {}, 'tracked'), el('th', {}, 'lost'), el('th', {}, 'keyframes'),
+      el('th', {}, 'map points'), el('th', {}, 'ATE ' + D.alignment + ' (m)'), el('th', {}, 'ATE se3'), el('th', {}, 'ATE sim3'),
+      ...filterKeys.map((k) => el('th', {}, filterLabel[k])));
+    const filterFlags = (f) => (f ? [['enhancement', 'E'], ['dynamic_removal', 'D'], ['distant', 'F']].map(([k, c]) => (f[k] ? c : '·')).join('') : '?');
     const bestAte = Math.min(...V.map((v) => (v.ate_rmse_m === undefined ? Infinity : v.ate_rmse_m)));
     const rows = V.map((v, i) => {
       const s = v.summary, a = s.accuracy || {}, fc = s.filter_counts || {};
-      return el('tr', {}, el('td', {}, swatch(VARIANT_COLORS[i % VARIANT_COLORS.length]), v.name), el('td', {}, fmt(s.tracked, 0) + '/' + fmt(s.frames, 0)),
+      return el('tr', {}, el('td', {}, swatch(VARIANT_COLORS[i % VARIANT_COLORS.length]), v.name), el('td', { style: 'font-family:monospace' }, filterFlags(s.filters)),
+        el('td', {}, fmt(s.tracked, 0) + '/' + fmt(s.frames, 0)),
         el('td', {}, fmt(s.lost, 0)), el('td', {}, fmt(s.keyframes, 0)), el('td', {}, fmt(s.map_points, 0)),
         el('td', { class: v.ate_rmse_m === bestAte ? 'crit' : '' }, fmt(v.ate_rmse_m, 4)), el('td', {}, fmt(a.ate_se3_rmse_m, 4)), el('td', {}, fmt(a.ate_sim3_rmse_m, 4)),
         ...filterKeys.map((k) => el('td', {}, fmt(fc[k], 0))));
     });
-    app.appendChild(panel('Accuracy and filter totals', el('table', {}, head, ...rows)));
+    app.appendChild(panel('Accuracy and filter totals', el('div', { class: 'scroll' }, el('table', {}, head, ...rows)),
+      el('div', { class: 'hint' }, 'filters: E enhancement, D dynamic removal, F distant filter (· off); filter columns are keypoints over the whole run.')));
 
     const trajPanel = panel('Trajectories');
     app.appendChild(trajPanel);
