@@ -106,6 +106,22 @@ def test_comparison_report(run_dir, tmp_path):
     assert color_pixels(image, layout["plot-filter"], "#1971c2") > 200
 
 
+def test_the_browser_check_sees_script_errors(run_dir, tmp_path):
+    # The same report with its data cut short: the page must not pass as drawn.
+    run("report", run_dir)
+    with open(os.path.join(run_dir, "report.html")) as f:
+        html = f.read()
+    start = html.index('<script id="report-data"')
+    broken = html[:start + 200] + html[html.index("</script>", start):]
+    path = str(tmp_path / "broken.html")
+    with open(path, "w") as f:
+        f.write(broken)
+    result = report_browser.open_report(path, str(tmp_path / "broken.png"), timeout=20)
+    assert result["ready"] != "1"
+    assert result["errors"] == "1"
+    assert any(line.startswith("console.error") for line in result["console"]), result["console"]
+
+
 def test_bad_run_folder_is_one_line_exit_2(tmp_path):
     os.makedirs(tmp_path / "empty")
     proc = subprocess.run([CLI, "report", str(tmp_path / "empty")], capture_output=True, text=True)
