@@ -298,6 +298,7 @@ TEST_F(ReportTest, PageInlinesTheLibrariesAndKeepsTheDataInsideItsScript) {
   const std::string html = ReadTextFile(out);
   EXPECT_NE(html.find("uPlot"), std::string::npos);
   EXPECT_NE(html.find("createREGL"), std::string::npos);
+  EXPECT_NE(html.find("Copyright (c) 2016 Mikola Lysenko"), std::string::npos);  // regl's licence
   EXPECT_NE(html.find("folder:\\u003c/script>\\u003cb>x"), std::string::npos);
   EXPECT_EQ(html.find("folder:</script>"), std::string::npos);
   // Nothing fetched at view time.

@@ -697,7 +697,13 @@ json ComparisonReportData(const std::vector<RunFolder>& runs, const std::vector<
 std::string RenderReportHtml(const json& data) {
   std::string html;
   const std::string title = "ademono report: " + data.value("title", std::string("run"));
-  html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
+  html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  // The inlined libraries' MIT licences travel with every copy.
+  html += "<!--\nuPlot 1.6.32, https://github.com/leeoniya/uPlot\n";
+  html += web::kUplotLicense;
+  html += "\nregl 2.1.1, https://github.com/regl-project/regl\n";
+  html += web::kReglLicense;
+  html += "\n-->\n<title>";
   html += HtmlEscape(title);
   html += "</title>\n<style>\n";
   html += web::kUplotCss;
