@@ -93,6 +93,26 @@ def test_run_report_draws_every_panel(run_dir):
     assert color_pixels(image, layout["map3d"], "#4dabf7", tol=30) > 20  # keyframes
 
 
+def test_timing_and_depth_scale_panels_draw(run_dir, tmp_path):
+    # The panels for per-frame stage times and the depth scale factor, on a copy of the real run
+    # with those fields filled in (test values: tracking dominates, scale drifts 1.00 -> 1.06).
+    copy = str(tmp_path / "run")
+    shutil.copytree(run_dir, copy)
+    with open(os.path.join(copy, "summary.json")) as f:
+        summary = json.load(f)
+    for i, frame in enumerate(summary["per_frame"]):
+        frame["ms"] = {"extraction": 8.0, "depth": 5.0, "detection": 3.0, "filter": 1.0,
+                       "tracking": 12.0 + i % 4, "mapping": 30.0 if frame["keyframe"] else 0.5}
+        frame["depth_scale"] = 1.0 + 0.001 * i
+    with open(os.path.join(copy, "summary.json"), "w") as f:
+        json.dump(summary, f)
+    run("report", copy)
+    layout, image = open_in_browser(os.path.join(copy, "report.html"), str(tmp_path / "shot.png"))
+    assert color_pixels(image, layout["plot-timing"], "#ff922b", tol=20) > 2_000  # tracking band
+    assert color_pixels(image, layout["plot-timing"], "#69db7c", tol=20) > 500    # mapping band
+    assert color_pixels(image, layout["plot-scale"], "#5f3dc4") > 200
+
+
 def test_comparison_report(run_dir, tmp_path):
     a, b = str(tmp_path / "full"), str(tmp_path / "again")
     shutil.copytree(run_dir, a)

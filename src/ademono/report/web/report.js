@@ -125,7 +125,7 @@
 
   // Stacked areas (cumulative sums drawn top first, so each band shows one part); the legend
   // shows each part's own value.
-  function stackedPlot(container, title, yLabel, t, parts, F, digits) {
+  function stackedPlot(container, title, yLabel, t, parts, F, digits, extra) {
     const n = t.length;
     const cum = [];
     const acc = new Array(n).fill(0);
@@ -137,10 +137,16 @@
     for (let k = parts.length - 1; k >= 0; k--) {
       const p = parts[k];
       series.push({
-        label: p.label, stroke: p.color, fill: p.color, width: 1,
+        label: p.label, stroke: p.color, fill: p.color, width: 1, points: { show: false },
         value: (u, v, si, i) => (i === null || i === undefined ? '–' : fmt(p.values[i], digits)),
       });
       data.push(cum[k]);
+    }
+    // Series drawn over the stack, not added to it.
+    for (const e of extra || []) {
+      series.push({ label: e.label, stroke: e.color, width: 2, dash: [6, 4], points: { show: false },
+        value: (u, v) => fmt(v, digits) });
+      data.push(e.values);
     }
     const opts = timeOpts(title, yLabel, series, F, false);
     opts.scales.y = { range: (u, min, max) => [0, max > 0 ? max * 1.05 : 1] };
@@ -426,12 +432,19 @@
     // Timing and critical path.
     const timePanel = panel('Time per frame');
     app.appendChild(timePanel);
+    // The main thread's stages stacked in pipeline order; the prefetch worker (depth + detection
+    // of the next frame, in parallel) as a dashed line: a frame costs the higher of the two.
+    const mainStages = ['extraction', 'filter', 'tracking', 'mapping'];
+    const workerStages = ['depth', 'detection'];
     const stages = Object.keys(F.ms);
     if (stages.length > 0) {
       const box = el('div', { id: 'plot-timing' });
       timePanel.appendChild(box);
-      stackedPlot(box, 'Per-module time per frame (stacked)', 'ms', F.t,
-        stages.map((s) => ({ label: s, values: F.ms[s], color: STAGE_COLORS[s] || '#adb5bd' })), F, 2);
+      const stacked = mainStages.filter((s) => F.ms[s]).concat(stages.filter((s) => !mainStages.includes(s) && !workerStages.includes(s)));
+      const worker = F.t.map((_, i) => workerStages.reduce((a, s) => a + (F.ms[s] ? F.ms[s][i] : 0), 0));
+      stackedPlot(box, 'Main-thread time per frame by module (stacked), prefetch worker dashed', 'ms', F.t,
+        stacked.map((s) => ({ label: s, values: F.ms[s], color: STAGE_COLORS[s] || '#adb5bd' })), F, 2,
+        workerStages.some((s) => F.ms[s]) ? [{ label: 'worker: depth + detection', values: worker, color: '#7048e8' }] : []);
     } else {
       timePanel.appendChild(note('No per-frame timing in this run.'));
     }
