@@ -61,7 +61,11 @@ fi
 # The run report's JavaScript (uPlot for the 2D plots, regl for the WebGL map view), pinned, from
 # the npm registry into .deps/web; CMake inlines the minified files into the binary.
 web_root="$here/.deps/web"
-if [ ! -f "$web_root/uPlot.iife.min.js" ] || [ ! -f "$web_root/uPlot.min.css" ] || [ ! -f "$web_root/regl.min.js" ]; then
+web_missing=0
+for f in uPlot.iife.min.js uPlot.min.css uPlot.LICENSE regl.min.js regl.LICENSE; do
+  [ -f "$web_root/$f" ] || web_missing=1
+done
+if [ "$web_missing" = 1 ]; then
   echo "setup: fetching the report's JavaScript (npm uplot@1.6.32, regl@2.1.1)"
   web_tmp="$(mktemp -d)"
   (cd "$web_tmp" && npm pack --silent uplot@1.6.32 regl@2.1.1 >/dev/null)
