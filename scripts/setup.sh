@@ -28,6 +28,7 @@ apt_packages=(
   libspdlog-dev libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
   python3-dev pybind11-dev python3-matplotlib
+  chromium
 )
 missing=()
 for p in "${apt_packages[@]}"; do
@@ -56,6 +57,29 @@ if [ ! -f "$ort_root/lib/libonnxruntime.so.1" ] || [ ! -f "$ort_root/include/onn
   cp "$tmp/package/Plugins/Linux/x64/libonnxruntime.so" "$ort_root.partial/lib/libonnxruntime.so.1"
   ln -sf libonnxruntime.so.1 "$ort_root.partial/lib/libonnxruntime.so"
   rm -rf "$ort_root" && mv "$ort_root.partial" "$ort_root"
+fi
+
+# The run report's JavaScript (uPlot for the 2D plots, regl for the WebGL map view), pinned, from
+# the npm registry into .deps/web; CMake inlines the minified files into the binary.
+web_root="$here/.deps/web"
+web_missing=0
+for f in uPlot.iife.min.js uPlot.min.css uPlot.LICENSE regl.min.js regl.LICENSE; do
+  [ -f "$web_root/$f" ] || web_missing=1
+done
+if [ "$web_missing" = 1 ]; then
+  echo "setup: fetching the report's JavaScript (npm uplot@1.6.32, regl@2.1.1)"
+  web_tmp="$(mktemp -d)"
+  (cd "$web_tmp" && npm pack --silent uplot@1.6.32 regl@2.1.1 >/dev/null)
+  mkdir -p "$web_tmp/uplot" "$web_tmp/regl"
+  tar -xzf "$web_tmp/uplot-1.6.32.tgz" -C "$web_tmp/uplot"
+  tar -xzf "$web_tmp/regl-2.1.1.tgz" -C "$web_tmp/regl"
+  rm -rf "$web_root.partial" && mkdir -p "$web_root.partial"
+  cp "$web_tmp/uplot/package/dist/uPlot.iife.min.js" "$web_tmp/uplot/package/dist/uPlot.min.css" \
+    "$web_tmp/uplot/package/LICENSE" "$web_root.partial/"
+  mv "$web_root.partial/LICENSE" "$web_root.partial/uPlot.LICENSE"
+  cp "$web_tmp/regl/package/dist/regl.min.js" "$web_root.partial/"
+  cp "$web_tmp/regl/package/LICENSE" "$web_root.partial/regl.LICENSE"
+  rm -rf "$web_tmp" "$web_root" && mv "$web_root.partial" "$web_root"
 fi
 
 if [ "$do_build" = 1 ]; then
