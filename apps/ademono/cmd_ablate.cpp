@@ -1,6 +1,6 @@
 // `ademono ablate`: the filter ablation (full / no_dynamic / no_distant / no_dynamic_no_distant /
 // no_enhancement) over one sequence; each variant's run outputs go into --out/<variant>/, the
-// comparison into --out/ablation.md and --out/ablation.json. The work is in slam/ablation.h.
+// comparison into --out/ablation.md and --out/ablation.json. The work is in runner/ablation.h.
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
@@ -18,7 +18,7 @@
 #include "ademono/detect/detector_factory.h"
 #include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
-#include "ademono/slam/ablation.h"
+#include "ademono/runner/ablation.h"
 #include "command.h"
 #include "run_options.h"
 
@@ -62,6 +62,8 @@ int Ablate(const AblateArgs& args) {
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
   options.variants = variants;
+  options.dataset = args.dataset;
+  options.config = config_path.string();
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.system.filter.seed = ParseSeed(args.seed);
   if (!args.frames.empty())

@@ -17,7 +17,7 @@
 #include "ademono/core/error.h"
 #include "ademono/depth/depth_factory.h"
 #include "ademono/depth/onnx_depth.h"
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
 #include "command.h"

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 #include "ademono/io/sequence.h"
 
 #include "cli_test_util.h"

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "ademono/depth/depth_provider.h"
+#include "ademono/perception/depth_provider.h"
 #include "ademono/io/sequence.h"
 
 namespace ademono {

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "ademono/depth/depth_factory.h"
-#include "ademono/depth/depth_provider.h"
+#include "ademono/perception/depth_provider.h"
 #include "ademono/depth/model_spec.h"
 #include "ademono/dnn/ort_session.h"
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "ademono/detect/detection.h"
+#include "ademono/perception/detection.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/dnn/ort_session.h"
 #include "ademono/dnn/preprocess.h"

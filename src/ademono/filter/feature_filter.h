@@ -16,7 +16,7 @@
 
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
-#include "ademono/detect/detection.h"
+#include "ademono/perception/detection.h"
 #include "ademono/filter/dynamic_params.h"
 
 namespace ademono {

@@ -6,7 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "ademono/detect/detection.h"
+#include "ademono/perception/detection.h"
 #include "ademono/filter/feature_filter.h"
 
 namespace ademono {
