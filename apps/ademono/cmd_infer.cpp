@@ -17,9 +17,9 @@
 #include "ademono/core/error.h"
 #include "ademono/depth/depth_factory.h"
 #include "ademono/depth/onnx_depth.h"
-#include "ademono/perception/detection_io.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
+#include "ademono/perception/detection_io.h"
 #include "command.h"
 
 namespace fs = std::filesystem;

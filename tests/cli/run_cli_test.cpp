@@ -41,9 +41,8 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
       RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 0:30 --viz " +
              (out_ / "viz").string() + " --out " + out_.string());
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const char* name :
-       {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "groundtruth.tum",
-        "summary.json"}) {
+  for (const char* name : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply",
+                           "groundtruth.tum", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out_ / name)) << name;
   }
   int viz_images = 0;

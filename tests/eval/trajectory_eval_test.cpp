@@ -174,7 +174,7 @@ TEST(PercentileTest, LinearBetweenOrderStatistics) {
   EXPECT_EQ(Percentile({7.0}, 0.95), 7.0);
   const std::vector<double> v{4.0, 1.0, 3.0, 2.0};  // unsorted on purpose
   EXPECT_DOUBLE_EQ(Percentile(v, 0.0), 1.0);
-  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), 2.5);   // numpy.percentile(v, 50)
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), 2.5);    // numpy.percentile(v, 50)
   EXPECT_DOUBLE_EQ(Percentile(v, 0.95), 3.85);  // numpy.percentile(v, 95)
   EXPECT_DOUBLE_EQ(Percentile(v, 1.0), 4.0);
   EXPECT_DOUBLE_EQ(Percentile(v, 0.5), ComputeStats(v).median);

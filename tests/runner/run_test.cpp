@@ -97,7 +97,7 @@ TEST_F(RunnerTest, ReportAddsUpAndIsAccurate) {
   EXPECT_GE(keyframes, r.keyframes);          // some may have been culled since
   EXPECT_EQ(kept, r.filter_totals.kept);
   EXPECT_EQ(boxes, r.filter_totals.boxes_small + r.filter_totals.boxes_large);
-  EXPECT_GT(boxes, 0);                         // the persons are in view
+  EXPECT_GT(boxes, 0);  // the persons are in view
   EXPECT_GT(r.filter_totals.RemovedDynamic(), 0);
   ASSERT_TRUE(r.accuracy.has_value()) << r.accuracy_note;
   EXPECT_EQ(r.accuracy->matched_poses, r.Tracked());
@@ -130,19 +130,20 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
 
   const nlohmann::json s = nlohmann::json::parse(ReadText(out / "summary.json"));
   EXPECT_EQ(s["schema"], "ademono.run/1");
-  EXPECT_EQ(Keys(s), (std::set<std::string>{"schema", "dataset", "config", "depth", "detector",
-                                            "seed", "deterministic", "filters", "frames",
-                                            "tracked", "untracked", "lost", "keyframes",
-                                            "map_points", "wall_seconds", "fps", "timing",
-                                            "filter_counts", "accuracy", "per_frame"}));
+  EXPECT_EQ(Keys(s),
+            (std::set<std::string>{"schema",    "dataset",       "config",        "depth",
+                                   "detector",  "seed",          "deterministic", "filters",
+                                   "frames",    "tracked",       "untracked",     "lost",
+                                   "keyframes", "map_points",    "wall_seconds",  "fps",
+                                   "timing",    "filter_counts", "accuracy",      "per_frame"}));
   EXPECT_EQ(Keys(s["filters"]),
             (std::set<std::string>{"enhancement", "dynamic_removal", "distant"}));
   EXPECT_EQ(Keys(s["timing"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
                                                       "tracking", "local_mapping"}));
-  EXPECT_EQ(Keys(s["accuracy"]),
-            (std::set<std::string>{"matched_poses", "ate_se3_rmse_m", "ate_sim3_rmse_m",
-                                   "sim3_scale", "rpe_30_frames_trans_rmse_m",
-                                   "rpe_30_frames_rot_rmse_deg"}));
+  EXPECT_EQ(
+      Keys(s["accuracy"]),
+      (std::set<std::string>{"matched_poses", "ate_se3_rmse_m", "ate_sim3_rmse_m", "sim3_scale",
+                             "rpe_30_frames_trans_rmse_m", "rpe_30_frames_rot_rmse_deg"}));
   EXPECT_EQ(s["config"], "built-in");
   EXPECT_EQ(s["frames"], kFrames);
   EXPECT_EQ(s["tracked"].get<size_t>() + s["untracked"].get<size_t>(), kFrames);
@@ -151,10 +152,10 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
   long long removed_dynamic = 0;
   for (size_t i = 0; i < kFrames; ++i) {
     const nlohmann::json& f = s["per_frame"][i];
-    EXPECT_EQ(Keys(f), (std::set<std::string>{"frame", "timestamp", "tracked", "state",
-                                              "relocalised", "keyframe", "keypoints", "kept",
-                                              "with_depth", "inliers", "dynamic_points_culled",
-                                              "filter", "ms"}))
+    EXPECT_EQ(Keys(f),
+              (std::set<std::string>{"frame", "timestamp", "tracked", "state", "relocalised",
+                                     "keyframe", "keypoints", "kept", "with_depth", "inliers",
+                                     "dynamic_points_culled", "filter", "ms"}))
         << i;
     EXPECT_EQ(Keys(f["ms"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
                                                     "tracking", "mapping"}));
@@ -176,8 +177,8 @@ TEST_F(RunnerTest, SecondAndSequentialRunWritesIdenticalOutputs) {
   const RunReport second = Run(false);
   EXPECT_FALSE(second.truth.has_value());  // not asked for
   WriteRunOutputs(second, sequential);
-  for (const char* file : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply",
-                           "groundtruth.tum"}) {
+  for (const char* file :
+       {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "groundtruth.tum"}) {
     const std::string first = ReadText(a / file);
     EXPECT_FALSE(first.empty()) << file;
     EXPECT_EQ(first, ReadText(sequential / file)) << file;

@@ -11,8 +11,8 @@
 #include <memory>
 #include <string>
 
-#include "ademono/perception/depth_provider.h"
 #include "ademono/io/sequence.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

@@ -3,10 +3,9 @@
 // are the dataset's sensor depth, cached depth maps, a simulated network (synth) or an ONNX model.
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "ademono/core/camera.h"
 #include "ademono/io/sequence.h"

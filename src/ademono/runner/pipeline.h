@@ -1,6 +1,6 @@
 #pragma once
-// The per-frame loop of a run (runner/run.h): load frame, compute its depth and detections, track it.
-// With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
+// The per-frame loop of a run (runner/run.h): load frame, compute its depth and detections, track
+// it. With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
 // while frame k is tracked (a one-frame prefetch); results are identical to the sequential loop
 // because providers are deterministic and tracking still sees frames in order.
 
@@ -8,9 +8,9 @@
 #include <functional>
 #include <vector>
 
+#include "ademono/io/sequence.h"
 #include "ademono/perception/depth_provider.h"
 #include "ademono/perception/detection.h"
-#include "ademono/io/sequence.h"
 #include "ademono/slam/system.h"
 
 namespace ademono {

@@ -140,8 +140,8 @@ StageTiming Timing(const std::vector<FrameReport>& frames, double FrameTiming::*
 RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* detector,
                       const RunOptions& options) {
   RunReport report;
-  report.dataset = options.dataset.empty() ? sequence.Kind() + ":" + sequence.Path().string()
-                                           : options.dataset;
+  report.dataset =
+      options.dataset.empty() ? sequence.Kind() + ":" + sequence.Path().string() : options.dataset;
   report.config = options.config;
   report.depth = depth != nullptr ? depth->Name() : "none";
   report.detector = detector != nullptr ? detector->Name() : "none";

@@ -80,8 +80,7 @@ struct RunOptions {
   // Score the filter labels against masks/ when the sequence has them (synthetic sequences).
   bool score_synthetic_truth = false;
   // Called after each frame, in order, on the calling thread (progress, --viz).
-  std::function<void(const FrameData&, const std::vector<Detection>&, const TrackResult&)>
-      on_frame;
+  std::function<void(const FrameData&, const std::vector<Detection>&, const TrackResult&)> on_frame;
 };
 
 struct RunReport {

@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "ademono/core/camera.h"
-#include "ademono/perception/detection.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/perception/detection.h"
 #include "ademono/slam/local_mapping.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
