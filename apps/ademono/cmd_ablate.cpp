@@ -1,6 +1,6 @@
 // `ademono ablate`: the filter ablation (full / no_dynamic / no_distant / no_dynamic_no_distant /
 // no_enhancement) over one sequence; each variant's run outputs go into --out/<variant>/, the
-// comparison into --out/ablation.md and --out/ablation.json. The work is in slam/ablation.h.
+// comparison into --out/ablation.md and --out/ablation.json. The work is in runner/ablation.h.
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
@@ -18,7 +18,8 @@
 #include "ademono/detect/detector_factory.h"
 #include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
-#include "ademono/slam/ablation.h"
+#include "ademono/report/report.h"
+#include "ademono/runner/ablation.h"
 #include "command.h"
 #include "run_options.h"
 
@@ -63,7 +64,10 @@ int Ablate(const AblateArgs& args) {
   options.system = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options.system);
   options.variants = variants;
+  options.dataset = args.dataset;
+  options.config = config_path.string();
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
+  options.detector = detector_options;
   if (!args.seed.empty()) options.system.filter.seed = ParseSeed(args.seed);
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &options.pipeline.start, &options.pipeline.end);
@@ -97,6 +101,13 @@ int Ablate(const AblateArgs& args) {
   }
   const std::vector<VariantResult> results =
       RunAblation(*sequence, depth.get(), detector.get(), options, args.out);
+  std::vector<fs::path> run_dirs;
+  std::vector<std::string> names;
+  for (const VariantResult& r : results) {
+    run_dirs.push_back(fs::path(args.out) / r.variant.name);
+    names.push_back(r.variant.name);
+  }
+  WriteComparisonReport(run_dirs, names, ReportOptions(), fs::path(args.out) / "report.html");
   std::cout << AblationMarkdown(results);
   return 0;
 }

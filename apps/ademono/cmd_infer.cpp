@@ -1,7 +1,7 @@
 // `ademono infer`: run the depth model and/or the detector over a dataset once and cache the
 // results, so `--depth cache:DIR/depth` and `--detector cache:DIR/detections.jsonl` replay them:
 //   DIR/depth/<frame name>.png   uint16 millimetres, 0 = invalid
-//   DIR/detections.jsonl         detections per frame (detect/detection_io.h)
+//   DIR/detections.jsonl         detections per frame (perception/detection_io.h)
 // Everything is written into a staging folder beside DIR and moved into place at the end, so a
 // failed run leaves no partial cache.
 #include <fmt/format.h>
@@ -17,9 +17,9 @@
 #include "ademono/core/error.h"
 #include "ademono/depth/depth_factory.h"
 #include "ademono/depth/onnx_depth.h"
-#include "ademono/detect/detection_io.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
+#include "ademono/perception/detection_io.h"
 #include "command.h"
 
 namespace fs = std::filesystem;

@@ -1,6 +1,6 @@
-// `ademono run`: SLAM over a dataset sequence. Writes trajectory.tum, trajectory.kitti,
-// keyframes.tum, map.ply and summary.json into --out (each atomically), optionally per-frame
-// feature images into --viz.
+// `ademono run`: SLAM over a dataset sequence through the runner (runner/run.h), whose writer
+// puts the run folder into --out (runner/run_writer.h); optionally per-frame feature images into
+// --viz.
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
@@ -20,12 +19,11 @@
 #include "ademono/core/file_util.h"
 #include "ademono/depth/depth_factory.h"
 #include "ademono/detect/detector_factory.h"
-#include "ademono/eval/trajectory_eval.h"
 #include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
-#include "ademono/io/trajectory.h"
-#include "ademono/slam/ablation.h"
-#include "ademono/slam/pipeline.h"
+#include "ademono/report/report.h"
+#include "ademono/runner/run.h"
+#include "ademono/runner/run_writer.h"
 #include "ademono/slam/system.h"
 #include "command.h"
 #include "run_options.h"
@@ -42,20 +40,6 @@ struct RunArgs : SequenceRunArgs {
   bool threaded = false;
 };
 
-void WritePly(const fs::path& path, const std::vector<System::ColoredPoint>& cloud) {
-  WriteFileAtomic(path, [&](std::ostream& os) {
-    os << "ply\nformat ascii 1.0\nelement vertex " << cloud.size()
-       << "\nproperty float x\nproperty float y\nproperty float z\n"
-          "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
-    char line[128];
-    for (const auto& p : cloud) {
-      std::snprintf(line, sizeof(line), "%.6f %.6f %.6f %d %d %d\n", p.position.x(), p.position.y(),
-                    p.position.z(), p.bgr[2], p.bgr[1], p.bgr[0]);
-      os << line;
-    }
-  });
-}
-
 // The filter's view of the frame (boxes as the filter grew them, keypoints by label, legend).
 void WriteViz(const fs::path& dir, const FrameData& frame, const std::vector<Detection>& detections,
               const TrackResult& r, const FilterOptions& filter) {
@@ -63,41 +47,6 @@ void WriteViz(const fs::path& dir, const FrameData& frame, const std::vector<Det
   name << "frame-" << std::setw(6) << std::setfill('0') << frame.index << ".jpg";
   WriteImageAtomic(dir / name.str(),
                    DrawFilterResult(frame.image, r.keypoints, r.labels, detections, filter));
-}
-
-nlohmann::json TimingJson(const std::vector<double>& values) {
-  return {{"median_ms", Percentile(values, 0.5)}, {"p95_ms", Percentile(values, 0.95)}};
-}
-
-// ATE (se3 and sim3 alignment) and RPE over one second of frames against the dataset's ground
-// truth, with the evaluation module (the same numbers `ademono eval` prints).
-nlohmann::json AccuracyJson(const std::vector<FrameData>& frames, const Trajectory& estimate) {
-  Trajectory gt;
-  for (const FrameData& f : frames) {
-    if (f.world_from_cam_gt) gt.push_back({f.timestamp, *f.world_from_cam_gt});
-  }
-  if (gt.size() < 3 || estimate.size() < 3) return nullptr;
-  nlohmann::json json;
-  try {
-    EvalOptions options;
-    options.alignment = Alignment::kSe3;
-    const EvalResult se3 = EvaluateTrajectories(gt, estimate, options);
-    options.alignment = Alignment::kSim3;
-    const EvalResult sim3 = EvaluateTrajectories(gt, estimate, options);
-    options.alignment = Alignment::kSe3;
-    options.rpe_delta = 30;
-    const EvalResult rpe = EvaluateTrajectories(gt, estimate, options);
-    json["matched_poses"] = se3.matched_poses;
-    json["ate_se3_rmse_m"] = se3.ape.rmse;
-    json["ate_sim3_rmse_m"] = sim3.ape.rmse;
-    json["sim3_scale"] = sim3.gt_from_est.scale;
-    json["rpe_30_frames_trans_rmse_m"] = rpe.rpe_trans.rmse;
-    json["rpe_30_frames_rot_rmse_deg"] = rpe.rpe_rot_deg.rmse;
-  } catch (const std::exception& e) {
-    spdlog::warn("accuracy not computed: {}", e.what());
-    return nullptr;
-  }
-  return json;
 }
 
 int Run(const RunArgs& args) {
@@ -118,10 +67,14 @@ int Run(const RunArgs& args) {
   if (args.no_distant_filter) options.filter.enable_distant_filter = false;
   if (args.threaded) options.mapping.deterministic = false;
 
-  PipelineOptions pipeline;
+  RunOptions run;
+  run.system = options;
+  run.dataset = args.dataset;
+  run.config = config_path.string();
+  run.detector = detector_options;
   if (!args.frames.empty())
-    ParseFrames(args.frames, sequence->Size(), &pipeline.start, &pipeline.end);
-  pipeline.overlap = !args.no_overlap;
+    ParseFrames(args.frames, sequence->Size(), &run.pipeline.start, &run.pipeline.end);
+  run.pipeline.overlap = !args.no_overlap;
 
   DepthFactoryContext context;
   context.sequence = sequence.get();
@@ -129,27 +82,17 @@ int Run(const RunArgs& args) {
   std::unique_ptr<DepthProvider> depth = MakeDepthProvider(args.depth, context);
   std::unique_ptr<Detector> detector = MakeDetector(args.detector, detector_options);
 
-  const fs::path out(args.out);
   const fs::path viz = args.viz;
-  System system(sequence->GetCamera(), options);
-  const size_t total = std::min(pipeline.end, sequence->Size()) - pipeline.start;
+  const size_t total = std::min(run.pipeline.end, sequence->Size()) - run.pipeline.start;
   const bool tty = isatty(STDERR_FILENO) != 0;
   const auto start_time = std::chrono::steady_clock::now();
   size_t done = 0;
   int lost_so_far = 0;
-  // Filter counts per frame and in total (slam/ablation.h FilterTotals).
-  FilterTotals filter_totals;
-  nlohmann::json filter_per_frame = nlohmann::json::array();
   if (!viz.empty()) fs::create_directories(viz);
-  pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&,
-                          const std::vector<Detection>& detections, const TrackResult& r) {
+  run.on_frame = [&](const FrameData& frame, const std::vector<Detection>& detections,
+                     const TrackResult& r) {
     ++done;
     if (!r.tracked && r.state != TrackingState::kNotInitialized) ++lost_so_far;
-    filter_totals.Add(r.filter_stats, r.num_keypoints);
-    nlohmann::json counts = FilterStatsJson(r.filter_stats);
-    counts["frame"] = frame.index;
-    counts["keypoints"] = r.num_keypoints;
-    filter_per_frame.push_back(std::move(counts));
     if (!viz.empty()) WriteViz(viz, frame, detections, r, options.filter);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
@@ -165,73 +108,27 @@ int Run(const RunArgs& args) {
                    lost_so_far);
     }
   };
-  const PipelineResult result =
-      RunPipeline(*sequence, depth.get(), detector.get(), system, pipeline);
-  system.Shutdown();
-
-  // Outputs.
-  const Trajectory trajectory = system.FrameTrajectory();
-  const Trajectory keyframes = system.KeyFrameTrajectory();
-  if (trajectory.empty()) {
+  const RunReport report = RunSequence(*sequence, depth.get(), detector.get(), run);
+  if (report.trajectory.empty()) {
     throw InputError(
         args.dataset +
         ": no frame could be tracked (the map never initialised: too little valid depth?)");
   }
-  WriteTumTrajectory(out / "trajectory.tum", trajectory);
-  WriteKittiTrajectory(out / "trajectory.kitti", trajectory);
-  WriteTumTrajectory(out / "keyframes.tum", keyframes);
-  WritePly(out / "map.ply", system.MapPointCloud());
+  if (sequence->HasGroundTruth() && !report.accuracy)
+    spdlog::warn("accuracy not computed: {}", report.accuracy_note);
+  WriteRunOutputs(report, args.out);
+  WriteRunReport(args.out, ReportOptions());  // report.html, from the files just written
 
-  std::vector<double> extraction, depth_ms, detection, filter, tracking, mapping;
-  for (const FrameTiming& t : result.timings) {
-    extraction.push_back(t.extraction_ms);
-    depth_ms.push_back(t.depth_ms);
-    detection.push_back(t.detection_ms);
-    filter.push_back(t.filter_ms);
-    tracking.push_back(t.tracking_ms);
-    mapping.push_back(t.mapping_ms);
+  std::cout << "tracked " << report.Tracked() << "/" << report.frames << " frames (lost "
+            << report.lost << "), " << report.keyframes << " keyframes, " << report.map_points
+            << " map points; tracking median " << std::fixed << std::setprecision(1)
+            << report.timing.at("tracking").median_ms << " ms/frame\n";
+  if (report.accuracy) {
+    std::cout << "ATE se3 " << std::setprecision(4) << report.accuracy->ate_se3_rmse_m
+              << " m, sim3 " << report.accuracy->ate_sim3_rmse_m << " m\n";
   }
-  nlohmann::json summary;
-  summary["dataset"] = args.dataset;
-  summary["config"] = config_path.string();
-  summary["depth"] = depth->Name();
-  summary["detector"] = detector->Name();
-  summary["seed"] = options.filter.seed;
-  summary["deterministic"] = options.mapping.deterministic;
-  summary["filters"] = {{"enhancement", options.filter.enable_enhancement},
-                        {"dynamic_removal", options.filter.enable_dynamic_removal},
-                        {"distant", options.filter.enable_distant_filter}};
-  summary["filter_counts"] = filter_totals.ToJson();
-  summary["filter_counts_per_frame"] = std::move(filter_per_frame);
-  summary["frames"] = result.frames;
-  summary["tracked"] = trajectory.size();
-  summary["untracked"] = result.frames - trajectory.size();
-  summary["lost"] = system.NumLost();
-  summary["keyframes"] = system.NumKeyFrames();
-  summary["map_points"] = system.NumMapPoints();
-  summary["wall_seconds"] = result.wall_seconds;
-  summary["fps"] = result.wall_seconds > 0 ? result.frames / result.wall_seconds : 0.0;
-  summary["timing"] = {
-      {"extraction", TimingJson(extraction)}, {"depth", TimingJson(depth_ms)},
-      {"detection", TimingJson(detection)},   {"filter", TimingJson(filter)},
-      {"tracking", TimingJson(tracking)},     {"local_mapping", TimingJson(mapping)}};
-  if (sequence->HasGroundTruth()) {
-    const nlohmann::json accuracy = AccuracyJson(result.ground_truth_frames, trajectory);
-    if (!accuracy.is_null()) summary["accuracy"] = accuracy;
-  }
-  WriteTextFileAtomic(out / "summary.json", summary.dump(2) + "\n");
-
-  std::cout << "tracked " << trajectory.size() << "/" << result.frames << " frames (lost "
-            << system.NumLost() << "), " << system.NumKeyFrames() << " keyframes, "
-            << system.NumMapPoints() << " map points; tracking median " << std::fixed
-            << std::setprecision(1) << Percentile(tracking, 0.5) << " ms/frame\n";
-  if (summary.contains("accuracy")) {
-    std::cout << "ATE se3 " << std::setprecision(4)
-              << summary["accuracy"]["ate_se3_rmse_m"].get<double>() << " m, sim3 "
-              << summary["accuracy"]["ate_sim3_rmse_m"].get<double>() << " m\n";
-  }
-  if (trajectory.size() < result.frames) {
-    std::cout << (result.frames - trajectory.size()) << " frames untracked (no pose written)\n";
+  if (report.Tracked() < report.frames) {
+    std::cout << (report.frames - report.Tracked()) << " frames untracked (no pose written)\n";
   }
   return 0;
 }

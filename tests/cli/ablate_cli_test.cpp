@@ -1,7 +1,7 @@
 // End-to-end test of `ademono ablate` on a tiny synthetic office (20 frames with walking persons
 // and ground-truth boxes): five variant folders with run outputs, the table's columns, truth
-// scoring, filter counts in `run`'s summary.json and --viz images; bad input gives one line and
-// exit code 2 with no output left.
+// scoring, filter counts in `run`'s summary.json (schema ademono.run/1) and --viz images; bad input
+// gives one line and exit code 2 with no output left.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -58,7 +58,8 @@ TEST_F(AblateCliTest, FiveVariantsAndTable) {
   for (const char* v :
        {"full", "no_dynamic", "no_distant", "no_dynamic_no_distant", "no_enhancement"}) {
     EXPECT_THAT(r.out, HasSubstr(std::string("| ") + v + " |"));
-    for (const char* f : {"trajectory.tum", "keyframes.tum", "summary.json"})
+    for (const char* f :
+         {"trajectory.tum", "keyframes.tum", "map.ply", "groundtruth.tum", "summary.json"})
       EXPECT_TRUE(fs::exists(out / v / f)) << v << "/" << f;
   }
   const std::string md = ReadFile(out / "ablation.md");
@@ -91,10 +92,11 @@ TEST_F(AblateCliTest, RunSummaryCountsFiltersAndVizWritesOneImagePerFrame) {
   std::ifstream in(out / "summary.json");
   const nlohmann::json summary = nlohmann::json::parse(in);
   const auto& total = summary["filter_counts"];
-  const auto& frames = summary["filter_counts_per_frame"];
-  ASSERT_EQ(frames.size(), 6u);
+  EXPECT_EQ(summary["schema"], "ademono.run/1");
+  ASSERT_EQ(summary["per_frame"].size(), 6u);
   long long removed_dynamic = 0, boxes = 0;
-  for (const auto& f : frames) {
+  for (const auto& frame : summary["per_frame"]) {
+    const auto& f = frame["filter"];
     removed_dynamic += f["removed_small_box"].get<long long>() +
                        f["removed_stage1"].get<long long>() + f["removed_stage2"].get<long long>() +
                        f["removed_box_vote"].get<long long>();

@@ -41,8 +41,8 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
       RunCli("run --dataset " + Dataset() + " --config " + Config() + " --frames 0:30 --viz " +
              (out_ / "viz").string() + " --out " + out_.string());
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const char* name :
-       {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "summary.json"}) {
+  for (const char* name : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply",
+                           "groundtruth.tum", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out_ / name)) << name;
   }
   int viz_images = 0;
@@ -50,7 +50,9 @@ TEST_F(RunCliTest, WritesAllOutputsForASlice) {
     viz_images += entry.path().extension() == ".jpg";
   EXPECT_EQ(viz_images, 30);
   const nlohmann::json summary = nlohmann::json::parse(ReadFile(out_ / "summary.json"));
+  EXPECT_EQ(summary["schema"], "ademono.run/1");
   EXPECT_EQ(summary["frames"], 30);
+  EXPECT_EQ(summary["per_frame"].size(), 30u);
   EXPECT_LT(summary["accuracy"]["ate_se3_rmse_m"].get<double>(), 0.03);
   EXPECT_EQ(summary["tracked"], 30);
   EXPECT_EQ(summary["lost"], 0);

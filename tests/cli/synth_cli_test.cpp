@@ -10,9 +10,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "ademono/detect/detection_io.h"
 #include "ademono/io/sequence.h"
-
+#include "ademono/perception/detection_io.h"
 #include "cli_test_util.h"
 
 namespace fs = std::filesystem;

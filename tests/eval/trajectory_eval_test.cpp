@@ -169,5 +169,16 @@ TEST(KittiOdometryTest, PerfectEstimateHasZeroErrorAndDriftIsMeasured) {
   EXPECT_NEAR(EvaluateKittiOdometry(gt, est, KittiAlignment::kSevenDof).ate_m, 0.0, 1e-6);
 }
 
+TEST(PercentileTest, LinearBetweenOrderStatistics) {
+  EXPECT_EQ(Percentile({}, 0.5), 0.0);
+  EXPECT_EQ(Percentile({7.0}, 0.95), 7.0);
+  const std::vector<double> v{4.0, 1.0, 3.0, 2.0};  // unsorted on purpose
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), 2.5);    // numpy.percentile(v, 50)
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.95), 3.85);  // numpy.percentile(v, 95)
+  EXPECT_DOUBLE_EQ(Percentile(v, 1.0), 4.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), ComputeStats(v).median);
+}
+
 }  // namespace
 }  // namespace ademono

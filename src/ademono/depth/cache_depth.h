@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-#include "ademono/depth/depth_provider.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

@@ -12,8 +12,8 @@
 #include <string>
 
 #include "ademono/core/depth_error.h"
-#include "ademono/depth/depth_provider.h"
 #include "ademono/io/sequence.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

@@ -1,25 +1,4 @@
 #pragma once
-// Where per-frame metric depth comes from. SLAM asks a DepthProvider for each frame; providers
-// are the dataset's sensor depth, cached depth maps, a simulated network (synth) or an ONNX model.
-
-#include <memory>
-#include <optional>
-#include <string>
-
-#include <opencv2/core.hpp>
-
-#include "ademono/core/camera.h"
-#include "ademono/io/sequence.h"
-
-namespace ademono {
-
-class DepthProvider {
- public:
-  virtual ~DepthProvider() = default;
-  virtual std::string Name() const = 0;
-  // CV_32FC1 depth in metres at the image's resolution, 0 where invalid.
-  // Must be deterministic for the same frame (and seed) and safe to call from a worker thread.
-  virtual cv::Mat Depth(const FrameData& frame, const Camera& camera) = 0;
-};
-
-}  // namespace ademono
+// Moved to perception/ (no ONNX Runtime there); this forwarder keeps includes of the old path
+// building until every module includes the new one.
+#include "ademono/perception/depth_provider.h"

@@ -14,9 +14,9 @@
 #include <string>
 
 #include "ademono/depth/depth_factory.h"
-#include "ademono/depth/depth_provider.h"
 #include "ademono/depth/model_spec.h"
 #include "ademono/dnn/ort_session.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "ademono/depth/depth_provider.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

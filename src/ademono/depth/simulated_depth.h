@@ -28,7 +28,7 @@
 #include <string>
 
 #include "ademono/depth/depth_factory.h"
-#include "ademono/depth/depth_provider.h"
+#include "ademono/perception/depth_provider.h"
 
 namespace ademono {
 

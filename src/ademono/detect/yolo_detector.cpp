@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "ademono/core/error.h"
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 
 namespace ademono {
 namespace {

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "ademono/detect/detection.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/dnn/ort_session.h"
 #include "ademono/dnn/preprocess.h"
+#include "ademono/perception/detection.h"
 
 namespace ademono {
 

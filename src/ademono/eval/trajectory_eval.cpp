@@ -135,6 +135,15 @@ ErrorStats ComputeStats(const std::vector<double>& errors) {
   return s;
 }
 
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const double pos = q * static_cast<double>(values.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(values.size() - 1, lo + 1);
+  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
+}
+
 std::vector<std::pair<size_t, size_t>> AssociateLikeEvo(const std::vector<double>& gt_stamps,
                                                         const std::vector<double>& est_stamps,
                                                         double max_diff) {

@@ -48,6 +48,9 @@ struct ErrorStats {
   size_t count = 0;
 };
 ErrorStats ComputeStats(const std::vector<double>& errors);
+// The q-quantile (0 <= q <= 1), linear between order statistics (numpy's default method); 0 for
+// an empty list. For the median of error lists use ComputeStats (numpy's median).
+double Percentile(std::vector<double> values, double q);
 
 // evo's sync.associate_trajectories: every stamp of the shorter trajectory is matched to the
 // nearest stamp of the longer one (first index on ties) if |dt| <= max_diff. A pose of the longer

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "ademono/detect/detection.h"
+#include "ademono/perception/detection.h"
 
 namespace ademono {
 

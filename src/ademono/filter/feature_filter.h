@@ -16,8 +16,8 @@
 
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
-#include "ademono/detect/detection.h"
 #include "ademono/filter/dynamic_params.h"
+#include "ademono/perception/detection.h"
 
 namespace ademono {
 

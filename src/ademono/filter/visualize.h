@@ -6,8 +6,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "ademono/detect/detection.h"
 #include "ademono/filter/feature_filter.h"
+#include "ademono/perception/detection.h"
 
 namespace ademono {
 

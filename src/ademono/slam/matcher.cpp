@@ -354,7 +354,7 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
         if (s < -margin || s > 1.0 + margin) continue;
       }
       const int d = DescriptorDistance(d1, f2.descriptors.row(static_cast<int>(j)));
-      if (d > kThLow) continue;
+      if (d > kOrbDistanceLow) continue;
       if (d < best) {
         second = best;
         best = d;
@@ -363,23 +363,24 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
         second = d;
       }
     }
-    if (best > kThLow || static_cast<float>(best) > nn_ratio_ * static_cast<float>(second)) continue;
+    if (best > kOrbDistanceLow || static_cast<float>(best) > nn_ratio_ * static_cast<float>(second))
+      continue;
     if (best < dist_for2[best_j]) {
       dist_for2[best_j] = best;
       best1_for2[best_j] = static_cast<int>(i);
     }
   }
-  std::vector<std::pair<size_t, float>> rotations;
+  RotationHistogram rotations;
   std::vector<std::pair<size_t, size_t>> found;
   for (size_t j = 0; j < f2.Size(); ++j) {
     if (best1_for2[j] < 0) continue;
     const size_t i = static_cast<size_t>(best1_for2[j]);
-    rotations.emplace_back(found.size(), AngleDiff(f1.keypoints[i].angle, f2.keypoints[j].angle));
+    rotations.Add(f1.keypoints[i].angle, f2.keypoints[j].angle, static_cast<int>(found.size()));
     found.emplace_back(i, j);
   }
   std::vector<bool> drop(found.size(), false);
   if (check_orientation_) {
-    for (size_t k : RotationOutliers(rotations)) drop[k] = true;
+    for (int k : rotations.InconsistentMatches()) drop[static_cast<size_t>(k)] = true;
   }
   int n = 0;
   for (size_t k = 0; k < found.size(); ++k) {

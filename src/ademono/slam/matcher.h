@@ -46,7 +46,7 @@ class Matcher {
            float radius) const;
 
   // Triangulation (ORB-SLAM's SearchForTriangulation without a vocabulary): keypoints of `k1` and
-  // `k2` that have no map point yet, matched by descriptor (best below kThLow, ratio test,
+  // `k2` that have no map point yet, matched by descriptor (best below kOrbDistanceLow, ratio test,
   // rotation check) among the candidates within the epipolar band of k2 (chi2 3.84 at the
   // candidate's level). A k1 keypoint with a depth prior only searches the part of its epipolar
   // line within `depth_sigmas` sigma of that depth (the whole line without one). Appends

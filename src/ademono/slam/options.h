@@ -13,7 +13,7 @@
 #include <string>
 
 #include "ademono/core/depth_error.h"
-#include "ademono/detect/detector_factory.h"
+#include "ademono/perception/detector_options.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/optimize/bundle_adjustment.h"

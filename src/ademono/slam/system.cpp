@@ -5,15 +5,9 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "ademono/core/timing.h"
+
 namespace ademono {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-}  // namespace
 
 System::System(const Camera& camera, const SystemOptions& options)
     : camera_(camera),
@@ -216,6 +210,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   result.tracked = out.tracked;
   result.inliers = out.inliers;
+  result.relocalised = out.relocalised;
   result.dynamic_points_culled = out.dynamic_points_culled;
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;

@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "ademono/core/camera.h"
-#include "ademono/detect/detection.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/perception/detection.h"
 #include "ademono/slam/local_mapping.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
@@ -28,6 +28,7 @@ struct TrackResult {
   bool tracked = false;
   std::optional<Rigid3d> cam_from_world;
   TrackingState state = TrackingState::kNotInitialized;
+  bool relocalised = false;  // tracked again by relocalisation after being lost
   bool new_keyframe = false;
   int num_keypoints = 0;   // extracted
   int num_kept = 0;        // after the filters

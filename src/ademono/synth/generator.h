@@ -24,7 +24,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 #include "ademono/synth/renderer.h"
 #include "ademono/synth/scenes.h"
 

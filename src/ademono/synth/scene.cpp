@@ -1,6 +1,6 @@
 #include "ademono/synth/scene.h"
 
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 
 namespace ademono::synth {
 

@@ -1,9 +1,9 @@
-#include "ademono/slam/pipeline.h"
+#include "ademono/runner/pipeline.h"
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <future>
+
+#include "ademono/core/timing.h"
 
 namespace ademono {
 namespace {
@@ -15,18 +15,13 @@ struct Prepared {
   double depth_ms = 0, detection_ms = 0;
 };
 
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
 Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {
   Prepared p;
   p.frame = sequence.Load(i);
-  auto start = std::chrono::steady_clock::now();
+  auto start = Now();
   if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
   p.depth_ms = MsSince(start);
-  start = std::chrono::steady_clock::now();
+  start = Now();
   if (detector != nullptr) p.detections = detector->Detect(p.frame);
   p.detection_ms = MsSince(start);
   return p;
@@ -34,20 +29,11 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
 
 }  // namespace
 
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double pos = q * static_cast<double>(values.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  const size_t hi = std::min(values.size() - 1, lo + 1);
-  return values[lo] + (pos - static_cast<double>(lo)) * (values[hi] - values[lo]);
-}
-
 PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detector* detector,
                            System& system, const PipelineOptions& options) {
   PipelineResult result;
   const size_t end = std::min(options.end, sequence.Size());
-  const auto wall_start = std::chrono::steady_clock::now();
+  const auto wall_start = Now();
   std::future<Prepared> next;
   for (size_t i = options.start; i < end; ++i) {
     Prepared current;

@@ -1,6 +1,6 @@
 #pragma once
-// The per-frame loop of `ademono run`: load frame, compute its depth and detections, track it.
-// With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
+// The per-frame loop of a run (runner/run.h): load frame, compute its depth and detections, track
+// it. With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
 // while frame k is tracked (a one-frame prefetch); results are identical to the sequential loop
 // because providers are deterministic and tracking still sees frames in order.
 
@@ -8,9 +8,9 @@
 #include <functional>
 #include <vector>
 
-#include "ademono/depth/depth_provider.h"
-#include "ademono/detect/detection.h"
 #include "ademono/io/sequence.h"
+#include "ademono/perception/depth_provider.h"
+#include "ademono/perception/detection.h"
 #include "ademono/slam/system.h"
 
 namespace ademono {
@@ -42,8 +42,5 @@ struct PipelineResult {
 // so in practice always given); `detector` may be null (no detections).
 PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detector* detector,
                            System& system, const PipelineOptions& options);
-
-// Median and 95th percentile of a list of values (0 for an empty list).
-double Percentile(std::vector<double> values, double q);
 
 }  // namespace ademono

@@ -1,4 +1,4 @@
-#include "ademono/detect/detection_io.h"
+#include "ademono/perception/detection_io.h"
 
 #include <charconv>
 #include <cmath>

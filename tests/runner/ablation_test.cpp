@@ -1,7 +1,6 @@
-// The ablation library: variants on a short 7-Scenes slice (outputs, ATE, filter counts that
-// follow the switches), a sequence without ground truth (ATE null with a note), and the
-// synthetic-truth scoring of keypoint labels against a moving-object mask.
-#include "ademono/slam/ablation.h"
+// The ablation library: variants on a short 7-Scenes slice (run folders, ATE, filter counts that
+// follow the switches) and a sequence without ground truth (ATE null with a note).
+#include "ademono/runner/ablation.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,23 +8,19 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "../slam/slam_test_util.h"
 #include "ademono/core/error.h"
-#include "ademono/depth/depth_factory.h"
-#include "slam_test_util.h"
+#include "runner_test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace ademono {
 namespace {
 
+using runner_test::FrameDepth;
 using testing_util::Slice;
 
-fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("ademono_ablation_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
-}
+fs::path TempDir(const std::string& name) { return runner_test::TempDir("ablation_" + name); }
 
 AblationOptions SliceOptions() {
   AblationOptions options;
@@ -57,9 +52,7 @@ class NoGroundTruth : public Sequence {
 
 TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
   const auto sequence = Slice(0, 15);
-  DepthFactoryContext context;
-  context.sequence = sequence.get();
-  auto depth = MakeDepthProvider("sensor", context);
+  FrameDepth depth;
   // A person box over the right half from frame 5 on: the dynamic filter has work to do.
   class HalfBox : public Detector {
    public:
@@ -77,10 +70,11 @@ TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
   options.variants = {DefaultAblationVariants()[0], DefaultAblationVariants()[1]};
   const fs::path out = TempDir("variants");
   const std::vector<VariantResult> results =
-      RunAblation(*sequence, depth.get(), &detector, options, out);
+      RunAblation(*sequence, &depth, &detector, options, out);
   ASSERT_EQ(results.size(), 2u);
   for (const VariantResult& r : results) {
-    for (const char* file : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "summary.json"})
+    for (const char* file : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply",
+                             "groundtruth.tum", "summary.json"})
       EXPECT_TRUE(fs::exists(out / r.variant.name / file)) << r.variant.name << " " << file;
     EXPECT_EQ(r.frames, 15u);
     EXPECT_EQ(r.tracked, 15u);
@@ -112,18 +106,25 @@ TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
   EXPECT_TRUE(fs::exists(out / "ablation.md"));
   std::ifstream summary_file(out / "full" / "summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["schema"], "ademono.run/1");  // the same run folder as `ademono run`
   EXPECT_EQ(summary["per_frame"].size(), 15u);
+  EXPECT_EQ(summary["accuracy"]["ate_se3_rmse_m"].get<double>(), *results[0].ate_se3_m);
+  EXPECT_FALSE(summary["filters"]["dynamic_removal"].is_null());
+  std::ifstream no_dynamic_file(out / "no_dynamic" / "summary.json");
+  EXPECT_FALSE(nlohmann::json::parse(no_dynamic_file)["filters"]["dynamic_removal"].get<bool>());
   fs::remove_all(out);
 }
 
 TEST(AblationTest, WithoutGroundTruthAteIsNullWithANote) {
   const NoGroundTruth sequence(Slice(0, 8));
-  DepthFactoryContext context;
-  auto depth = MakeDepthProvider("sensor", context);
+  FrameDepth depth;
   AblationOptions options = SliceOptions();
   const fs::path out = TempDir("nogt");
-  const VariantResult r = RunAblationVariant(sequence, depth.get(), nullptr, options,
+  const VariantResult r = RunAblationVariant(sequence, &depth, nullptr, options,
                                              DefaultAblationVariants()[0], out / "full");
+  EXPECT_FALSE(fs::exists(out / "full" / "groundtruth.tum"));
+  std::ifstream summary_file(out / "full" / "summary.json");
+  EXPECT_FALSE(nlohmann::json::parse(summary_file).contains("accuracy"));
   EXPECT_FALSE(r.ate_se3_m.has_value());
   EXPECT_EQ(r.note, "dataset has no ground truth");
   EXPECT_TRUE(r.ToJson()["ate_se3_rmse_m"].is_null());
@@ -139,56 +140,6 @@ TEST(AblationTest, DefaultVariantsAreTheFivePaperVariants) {
   EXPECT_FALSE(v[3].dynamic_removal || v[3].distant_filter);
   EXPECT_FALSE(v[4].enhancement);
   EXPECT_TRUE(v[4].dynamic_removal && v[4].distant_filter);
-}
-
-TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
-  const fs::path dir = TempDir("truth");
-  fs::create_directories(dir / "masks");
-  cv::Mat mask(100, 200, CV_8UC1, cv::Scalar(0));
-  mask(cv::Rect(0, 0, 50, 100)).setTo(255);  // a moving object on the left
-  cv::imwrite((dir / "masks" / "f0.png").string(), mask);
-  const SyntheticTruth truth(dir);
-  ASSERT_TRUE(truth.Available());
-  FrameData frame;
-  frame.name = "f0";
-  frame.image = cv::Mat(100, 200, CV_8UC3, cv::Scalar::all(0));
-  Detection moving, standing;
-  moving.class_id = standing.class_id = 0;
-  moving.box = cv::Rect2f(0, 0, 50, 100);
-  standing.box = cv::Rect2f(120, 10, 40, 80);  // no moving pixels: the static person
-  Detection parked;  // a static car; a chair box (class 56) is not a dynamic class
-  parked.class_id = 2;
-  parked.box = cv::Rect2f(60, 60, 30, 30);
-  Detection chair;
-  chair.class_id = 56;
-  chair.box = cv::Rect2f(170, 10, 20, 20);
-  const std::vector<cv::KeyPoint> kps{{10, 10, 7},  {20, 50, 7},  {30, 80, 7},
-                                      {130, 20, 7}, {140, 50, 7}, {90, 50, 7},
-                                      {70, 70, 7},  {80, 75, 7},  {175, 15, 7}};
-  const std::vector<PointLabel> labels{PointLabel::kDynamicStage1,
-                                       PointLabel::kKept,
-                                       PointLabel::kEnhancementDropped,
-                                       PointLabel::kKept,
-                                       PointLabel::kDynamicBoxVote,
-                                       PointLabel::kKept,
-                                       PointLabel::kDynamicSmallBox,
-                                       PointLabel::kKept,
-                                       PointLabel::kKept};
-  TruthCounts counts;
-  truth.Score(frame, {moving, standing, parked, chair}, kps, labels, &counts);
-  EXPECT_EQ(counts.moving_keypoints, 2);  // the enhancement-dropped one does not count
-  EXPECT_EQ(counts.moving_removed, 1);
-  EXPECT_EQ(counts.moving_kept, 1);
-  EXPECT_EQ(counts.static_person_keypoints, 2);
-  EXPECT_EQ(counts.static_person_removed, 1);
-  // Static points in dynamic-class boxes: the static person's two and the parked car's two.
-  EXPECT_EQ(counts.static_in_box_keypoints, 4);
-  EXPECT_EQ(counts.static_in_box_removed, 2);
-
-  frame.name = "missing";
-  EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);
-  EXPECT_FALSE(SyntheticTruth(dir / "nothing").Available());
-  fs::remove_all(dir);
 }
 
 }  // namespace

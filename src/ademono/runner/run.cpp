@@ -1,0 +1,277 @@
+#include "ademono/runner/run.h"
+
+#include <stdexcept>
+
+#include "ademono/eval/trajectory_eval.h"
+
+namespace ademono {
+
+void FilterTotals::Add(const FilterStats& s, int num_keypoints) {
+  boxes_small += s.boxes_small;
+  boxes_large += s.boxes_large;
+  removed_enhancement += s.removed_enhancement;
+  removed_small_box += s.removed_small_box;
+  removed_stage1 += s.removed_stage1;
+  removed_stage2 += s.removed_stage2;
+  removed_box_vote += s.removed_box_vote;
+  removed_distant += s.removed_distant;
+  distant_candidates += s.distant_candidates;
+  kept += s.kept;
+  keypoints += num_keypoints;
+  stage1_frames += s.stage1_ran;
+  stage1_compensated_frames += s.stage1_compensated;
+}
+
+nlohmann::json FilterTotals::ToJson() const {
+  nlohmann::json j{{"keypoints", keypoints},
+                   {"kept", kept},
+                   {"boxes_small", boxes_small},
+                   {"boxes_large", boxes_large},
+                   {"removed_enhancement", removed_enhancement},
+                   {"removed_small_box", removed_small_box},
+                   {"removed_stage1", removed_stage1},
+                   {"removed_stage2", removed_stage2},
+                   {"removed_box_vote", removed_box_vote},
+                   {"removed_dynamic", RemovedDynamic()},
+                   {"removed_distant", removed_distant},
+                   {"distant_candidates", distant_candidates},
+                   {"stage1_frames", stage1_frames},
+                   {"stage1_compensated_frames", stage1_compensated_frames}};
+  j["distant_drop_rate"] =
+      distant_candidates > 0
+          ? nlohmann::json(static_cast<double>(removed_distant) / distant_candidates)
+          : nlohmann::json(nullptr);
+  return j;
+}
+
+nlohmann::json FilterStatsJson(const FilterStats& s) {
+  return {{"boxes_small", s.boxes_small},
+          {"boxes_large", s.boxes_large},
+          {"removed_enhancement", s.removed_enhancement},
+          {"removed_small_box", s.removed_small_box},
+          {"removed_stage1", s.removed_stage1},
+          {"removed_stage2", s.removed_stage2},
+          {"removed_box_vote", s.removed_box_vote},
+          {"removed_distant", s.removed_distant},
+          {"distant_candidates", s.distant_candidates},
+          {"stage1_compensated", s.stage1_compensated},
+          {"kept", s.kept}};
+}
+
+const char* TrackingStateName(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized:
+      return "not_initialized";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kLost:
+      return "lost";
+  }
+  throw std::logic_error("TrackingStateName: unknown state");
+}
+
+nlohmann::json RunAccuracy::ToJson() const {
+  return {{"matched_poses", matched_poses},
+          {"ate_se3_rmse_m", ate_se3_rmse_m},
+          {"ate_sim3_rmse_m", ate_sim3_rmse_m},
+          {"sim3_scale", sim3_scale},
+          {"rpe_30_frames_trans_rmse_m", rpe_30_frames_trans_rmse_m},
+          {"rpe_30_frames_rot_rmse_deg", rpe_30_frames_rot_rmse_deg}};
+}
+
+std::optional<RunAccuracy> ComputeAccuracy(const Trajectory& ground_truth,
+                                           const Trajectory& estimate, std::string* note) {
+  if (ground_truth.empty()) {
+    *note = "dataset has no ground truth";
+    return std::nullopt;
+  }
+  if (estimate.size() < 3) {
+    *note = "fewer than 3 tracked frames";
+    return std::nullopt;
+  }
+  try {
+    EvalOptions options;
+    options.alignment = Alignment::kSe3;
+    const EvalResult se3 = EvaluateTrajectories(ground_truth, estimate, options);
+    options.alignment = Alignment::kSim3;
+    const EvalResult sim3 = EvaluateTrajectories(ground_truth, estimate, options);
+    options.alignment = Alignment::kSe3;
+    options.rpe_delta = 30;
+    const EvalResult rpe = EvaluateTrajectories(ground_truth, estimate, options);
+    RunAccuracy a;
+    a.matched_poses = se3.matched_poses;
+    a.ate_se3_rmse_m = se3.ape.rmse;
+    a.ate_sim3_rmse_m = sim3.ape.rmse;
+    a.sim3_scale = sim3.gt_from_est.scale;
+    a.rpe_30_frames_trans_rmse_m = rpe.rpe_trans.rmse;
+    a.rpe_30_frames_rot_rmse_deg = rpe.rpe_rot_deg.rmse;
+    return a;
+  } catch (const std::exception& e) {
+    *note = std::string("ATE not computed: ") + e.what();
+    return std::nullopt;
+  }
+}
+
+namespace {
+
+// Ground-truth poses at the estimate's frames, with the association the accuracy uses.
+Trajectory AssociatedGroundTruth(const Trajectory& ground_truth, const Trajectory& estimate) {
+  if (ground_truth.empty() || estimate.empty()) return {};
+  std::vector<double> gt_stamps, est_stamps;
+  for (const StampedPose& p : ground_truth) gt_stamps.push_back(p.timestamp);
+  for (const StampedPose& p : estimate) est_stamps.push_back(p.timestamp);
+  Trajectory associated;
+  for (const auto& [i, j] : AssociateLikeEvo(gt_stamps, est_stamps, EvalOptions().max_diff)) {
+    (void)j;
+    associated.push_back(ground_truth[i]);
+  }
+  return associated;
+}
+
+StageTiming Timing(const std::vector<FrameReport>& frames, double FrameTiming::*stage) {
+  std::vector<double> values;
+  values.reserve(frames.size());
+  for (const FrameReport& f : frames) values.push_back(f.ms.*stage);
+  return {Percentile(values, 0.5), Percentile(std::move(values), 0.95)};
+}
+
+}  // namespace
+
+RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* detector,
+                      const RunOptions& options) {
+  RunReport report;
+  report.dataset =
+      options.dataset.empty() ? sequence.Kind() + ":" + sequence.Path().string() : options.dataset;
+  report.config = options.config;
+  report.depth = depth != nullptr ? depth->Name() : "none";
+  report.detector = detector != nullptr ? detector->Name() : "none";
+  report.options = options.system;
+  report.detector_options = options.detector;
+
+  System system(sequence.GetCamera(), options.system);
+  const SyntheticTruth truth(sequence.Path());
+  const bool score = options.score_synthetic_truth && truth.Available();
+  if (score) report.truth = TruthCounts{};
+  PipelineOptions pipeline = options.pipeline;
+  pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&,
+                          const std::vector<Detection>& detections, const TrackResult& r) {
+    FrameReport f;
+    f.frame = frame.index;
+    f.timestamp = frame.timestamp;
+    f.tracked = r.tracked;
+    f.state = r.state;
+    f.relocalised = r.relocalised;
+    f.keyframe = r.new_keyframe;
+    f.keypoints = r.num_keypoints;
+    f.kept = r.num_kept;
+    f.with_depth = r.num_with_depth;
+    f.inliers = r.inliers;
+    f.dynamic_points_culled = r.dynamic_points_culled;
+    f.filter = r.filter_stats;
+    report.per_frame.push_back(f);
+    report.filter_totals.Add(r.filter_stats, r.num_keypoints);
+    if (score) truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth);
+    if (options.on_frame) options.on_frame(frame, detections, r);
+  };
+  const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
+  system.Shutdown();
+
+  // The pipeline measured depth and detection (prepared ahead); the rest came with each frame.
+  for (size_t i = 0; i < report.per_frame.size() && i < run.timings.size(); ++i)
+    report.per_frame[i].ms = run.timings[i];
+  report.frames = run.frames;
+  report.wall_seconds = run.wall_seconds;
+  report.lost = system.NumLost();
+  report.keyframes = system.NumKeyFrames();
+  report.map_points = system.NumMapPoints();
+  report.trajectory = system.FrameTrajectory();
+  report.keyframe_trajectory = system.KeyFrameTrajectory();
+  if (options.system.depth.IsPrior()) {
+    std::map<size_t, double> scales;
+    for (const auto& [index, scale] : system.DepthScales()) scales[index] = scale;
+    for (FrameReport& f : report.per_frame) {
+      if (auto it = scales.find(f.frame); f.tracked && it != scales.end()) f.depth_scale = it->second;
+    }
+  }
+  report.map_cloud = system.MapPointCloud();
+  report.timing = {{"extraction", Timing(report.per_frame, &FrameTiming::extraction_ms)},
+                   {"depth", Timing(report.per_frame, &FrameTiming::depth_ms)},
+                   {"detection", Timing(report.per_frame, &FrameTiming::detection_ms)},
+                   {"filter", Timing(report.per_frame, &FrameTiming::filter_ms)},
+                   {"tracking", Timing(report.per_frame, &FrameTiming::tracking_ms)},
+                   {"local_mapping", Timing(report.per_frame, &FrameTiming::mapping_ms)}};
+
+  Trajectory ground_truth;
+  for (const FrameData& f : run.ground_truth_frames) {
+    if (f.world_from_cam_gt) ground_truth.push_back({f.timestamp, *f.world_from_cam_gt});
+  }
+  report.accuracy = ComputeAccuracy(ground_truth, report.trajectory, &report.accuracy_note);
+  report.ground_truth = AssociatedGroundTruth(ground_truth, report.trajectory);
+  return report;
+}
+
+nlohmann::json RunSummaryJson(const RunReport& report) {
+  const SystemOptions& o = report.options;
+  nlohmann::json j;
+  j["schema"] = "ademono.run/1";
+  j["dataset"] = report.dataset;
+  j["config"] = report.config;
+  j["depth"] = report.depth;
+  j["detector"] = report.detector;
+  j["seed"] = o.filter.seed;
+  j["deterministic"] = o.mapping.deterministic;
+  j["filters"] = {{"enhancement", o.filter.enable_enhancement},
+                  {"dynamic_removal", o.filter.enable_dynamic_removal},
+                  {"distant", o.filter.enable_distant_filter}};
+  j["frames"] = report.frames;
+  j["tracked"] = report.Tracked();
+  j["untracked"] = report.frames - report.Tracked();
+  j["lost"] = report.lost;
+  j["keyframes"] = report.keyframes;
+  j["map_points"] = report.map_points;
+  j["wall_seconds"] = report.wall_seconds;
+  j["fps"] = report.Fps();
+  nlohmann::json timing = nlohmann::json::object();
+  for (const auto& [stage, t] : report.timing)
+    timing[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+  j["timing"] = std::move(timing);
+  j["filter_counts"] = report.filter_totals.ToJson();
+  if (report.accuracy) j["accuracy"] = report.accuracy->ToJson();
+  std::vector<double> depth_scales;
+  for (const FrameReport& f : report.per_frame) {
+    if (f.depth_scale) depth_scales.push_back(*f.depth_scale);
+  }
+  if (!depth_scales.empty()) {
+    // How far each frame's network depth had to be corrected (1 = it agreed with the map).
+    j["depth_scale"] = {{"median", Percentile(depth_scales, 0.5)},
+                        {"p10", Percentile(depth_scales, 0.1)},
+                        {"p90", Percentile(depth_scales, 0.9)}};
+  }
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (const FrameReport& f : report.per_frame) {
+    per_frame.push_back({{"frame", f.frame},
+                         {"timestamp", f.timestamp},
+                         {"tracked", f.tracked},
+                         {"state", TrackingStateName(f.state)},
+                         {"relocalised", f.relocalised},
+                         {"keyframe", f.keyframe},
+                         {"keypoints", f.keypoints},
+                         {"kept", f.kept},
+                         {"with_depth", f.with_depth},
+                         {"inliers", f.inliers},
+                         {"dynamic_points_culled", f.dynamic_points_culled},
+                         {"filter", FilterStatsJson(f.filter)},
+                         {"ms",
+                          {{"extraction", f.ms.extraction_ms},
+                           {"depth", f.ms.depth_ms},
+                           {"detection", f.ms.detection_ms},
+                           {"filter", f.ms.filter_ms},
+                           {"tracking", f.ms.tracking_ms},
+                           {"mapping", f.ms.mapping_ms}}}});
+    if (f.depth_scale) per_frame.back()["depth_scale"] = *f.depth_scale;
+  }
+  j["per_frame"] = std::move(per_frame);
+  return j;
+}
+
+}  // namespace ademono

@@ -1,0 +1,95 @@
+#include "ademono/runner/synthetic_truth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+
+#include "ademono/core/error.h"
+#include "ademono/core/file_util.h"
+
+namespace fs = std::filesystem;
+
+namespace ademono {
+
+nlohmann::json TruthCounts::ToJson() const {
+  auto ratio = [](long long a, long long b) {
+    return b > 0 ? nlohmann::json(static_cast<double>(a) / b) : nlohmann::json(nullptr);
+  };
+  return {{"moving_keypoints", moving_keypoints},
+          {"moving_removed", moving_removed},
+          {"moving_kept", moving_kept},
+          {"moving_removed_ratio", ratio(moving_removed, moving_keypoints)},
+          {"static_person_keypoints", static_person_keypoints},
+          {"static_person_removed", static_person_removed},
+          {"static_person_removed_ratio", ratio(static_person_removed, static_person_keypoints)},
+          {"static_in_box_keypoints", static_in_box_keypoints},
+          {"static_in_box_removed", static_in_box_removed},
+          {"static_in_box_removed_ratio", ratio(static_in_box_removed, static_in_box_keypoints)}};
+}
+
+SyntheticTruth::SyntheticTruth(const fs::path& sequence_dir) : masks_dir_(sequence_dir / "masks") {
+  available_ = fs::is_directory(masks_dir_);
+}
+
+namespace {
+
+cv::Point Pixel(const cv::KeyPoint& kp, const cv::Size& size) {
+  return {std::clamp(static_cast<int>(std::lround(kp.pt.x)), 0, size.width - 1),
+          std::clamp(static_cast<int>(std::lround(kp.pt.y)), 0, size.height - 1)};
+}
+
+}  // namespace
+
+void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>& detections,
+                           const std::vector<cv::KeyPoint>& keypoints,
+                           const std::vector<PointLabel>& labels, TruthCounts* counts) const {
+  const fs::path path = masks_dir_ / (frame.name + ".png");
+  RequireFile(path);
+  const cv::Mat mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  if (mask.empty()) ThrowInputError(path, "cannot decode the mask image");
+  if (!frame.image.empty() && mask.size() != frame.image.size())
+    ThrowInputError(path, "mask size differs from the image size");
+  // The static person: the person box with the fewest moving pixels, if under 20%.
+  std::optional<cv::Rect> static_box;
+  double best = 0.2;
+  const cv::Rect bounds(0, 0, mask.cols, mask.rows);
+  for (const Detection& d : detections) {
+    if (d.class_id != 0) continue;
+    const cv::Rect box = cv::Rect(d.box) & bounds;
+    if (box.area() == 0) continue;
+    const double moving = cv::countNonZero(mask(box) > 127) / static_cast<double>(box.area());
+    if (moving < best) {
+      best = moving;
+      static_box = box;
+    }
+  }
+  for (size_t i = 0; i < keypoints.size() && i < labels.size(); ++i) {
+    const cv::Point p = Pixel(keypoints[i], mask.size());
+    // Only keypoints the dynamic filter judged: enhancement drops happen before it.
+    if (labels[i] == PointLabel::kEnhancementDropped) continue;
+    const bool dynamic = IsDynamic(labels[i]);
+    if (mask.at<uint8_t>(p) > 127) {
+      ++counts->moving_keypoints;
+      if (dynamic) ++counts->moving_removed;
+      if (labels[i] == PointLabel::kKept) ++counts->moving_kept;
+    } else {
+      if (static_box && static_box->contains(p)) {
+        ++counts->static_person_keypoints;
+        if (dynamic) ++counts->static_person_removed;
+      }
+      const auto& classes = DefaultDynamicClassIds();
+      const bool in_box =
+          std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
+            return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
+                   d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
+          });
+      if (in_box) {
+        ++counts->static_in_box_keypoints;
+        if (dynamic) ++counts->static_in_box_removed;
+      }
+    }
+  }
+}
+
+}  // namespace ademono

@@ -1,0 +1,50 @@
+#pragma once
+// Scores a run's per-keypoint filter labels against a synthetic sequence's truth
+// (`ademono synth` writes masks/<frame name>.png of moving objects): how many keypoints on moving
+// objects the dynamic filter removed, and how many on a static person-class object (the office
+// mannequin). Used by the ablation (runner/ablation.h).
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "ademono/filter/feature_filter.h"
+#include "ademono/io/sequence.h"
+#include "ademono/perception/detection.h"
+
+namespace ademono {
+
+// Keypoints scored against synthetic ground truth. Only keypoints that reach the dynamic filter
+// count (not dropped by the enhancement before it), and only dynamic-removal labels count as
+// removed (a distant drop is not the dynamic filter's doing).
+struct TruthCounts {
+  long long moving_keypoints = 0;         // keypoints whose pixel is in the moving-object mask
+  long long moving_removed = 0;           // ... labelled dynamic
+  long long moving_kept = 0;              // ... labelled kept (used for tracking)
+  long long static_person_keypoints = 0;  // in the static person box, not on a moving object
+  long long static_person_removed = 0;    // ... labelled dynamic
+  // In any box of a dynamic class (the detector's box, not grown) but not on a moving object:
+  // static objects such as parked cars, and background seen inside boxes.
+  long long static_in_box_keypoints = 0;
+  long long static_in_box_removed = 0;  // ... labelled dynamic
+  nlohmann::json ToJson() const;
+};
+
+// Reads masks/<frame name>.png of a synthetic sequence and finds the static person box of a
+// frame (a person box with under 20% moving pixels; the mannequin). Available() is false when
+// the sequence has no masks/ folder.
+class SyntheticTruth {
+ public:
+  explicit SyntheticTruth(const std::filesystem::path& sequence_dir);
+  bool Available() const { return available_; }
+  // Throws InputError when the frame's mask is missing or not the image size.
+  void Score(const FrameData& frame, const std::vector<Detection>& detections,
+             const std::vector<cv::KeyPoint>& keypoints, const std::vector<PointLabel>& labels,
+             TruthCounts* counts) const;
+
+ private:
+  std::filesystem::path masks_dir_;
+  bool available_ = false;
+};
+
+}  // namespace ademono

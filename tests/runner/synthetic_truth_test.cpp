@@ -1,0 +1,67 @@
+// Scoring of keypoint labels against a synthetic sequence's moving-object mask.
+#include "ademono/runner/synthetic_truth.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "ademono/core/error.h"
+#include "runner_test_util.h"
+
+namespace fs = std::filesystem;
+
+namespace ademono {
+namespace {
+
+TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
+  const fs::path dir = runner_test::TempDir("truth");
+  fs::create_directories(dir / "masks");
+  cv::Mat mask(100, 200, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 50, 100)).setTo(255);  // a moving object on the left
+  cv::imwrite((dir / "masks" / "f0.png").string(), mask);
+  const SyntheticTruth truth(dir);
+  ASSERT_TRUE(truth.Available());
+  FrameData frame;
+  frame.name = "f0";
+  frame.image = cv::Mat(100, 200, CV_8UC3, cv::Scalar::all(0));
+  Detection moving, standing;
+  moving.class_id = standing.class_id = 0;
+  moving.box = cv::Rect2f(0, 0, 50, 100);
+  standing.box = cv::Rect2f(120, 10, 40, 80);  // no moving pixels: the static person
+  Detection parked;  // a static car; a chair box (class 56) is not a dynamic class
+  parked.class_id = 2;
+  parked.box = cv::Rect2f(60, 60, 30, 30);
+  Detection chair;
+  chair.class_id = 56;
+  chair.box = cv::Rect2f(170, 10, 20, 20);
+  const std::vector<cv::KeyPoint> kps{{10, 10, 7},  {20, 50, 7},  {30, 80, 7},
+                                      {130, 20, 7}, {140, 50, 7}, {90, 50, 7},
+                                      {70, 70, 7},  {80, 75, 7},  {175, 15, 7}};
+  const std::vector<PointLabel> labels{PointLabel::kDynamicStage1,
+                                       PointLabel::kKept,
+                                       PointLabel::kEnhancementDropped,
+                                       PointLabel::kKept,
+                                       PointLabel::kDynamicBoxVote,
+                                       PointLabel::kKept,
+                                       PointLabel::kDynamicSmallBox,
+                                       PointLabel::kKept,
+                                       PointLabel::kKept};
+  TruthCounts counts;
+  truth.Score(frame, {moving, standing, parked, chair}, kps, labels, &counts);
+  EXPECT_EQ(counts.moving_keypoints, 2);  // the enhancement-dropped one does not count
+  EXPECT_EQ(counts.moving_removed, 1);
+  EXPECT_EQ(counts.moving_kept, 1);
+  EXPECT_EQ(counts.static_person_keypoints, 2);
+  EXPECT_EQ(counts.static_person_removed, 1);
+  // Static points in dynamic-class boxes: the static person's two and the parked car's two.
+  EXPECT_EQ(counts.static_in_box_keypoints, 4);
+  EXPECT_EQ(counts.static_in_box_removed, 2);
+
+  frame.name = "missing";
+  EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);
+  EXPECT_FALSE(SyntheticTruth(dir / "nothing").Available());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ademono
