@@ -82,11 +82,18 @@ def read_pose(path):
     return m
 
 
+# --depth-dir: depth maps from elsewhere (e.g. `ademono infer`'s network depth cache, 16-bit mm
+# PNGs named after the colour image) fed to every method as if they were the sensor's.
+DEPTH_DIR = None
+
+
 def load_frame(directory, number, color_path):
     color = cv2.imread(color_path, cv2.IMREAD_COLOR)
     if color is None:
         fail(color_path + ": image does not decode")
     depth_path = os.path.join(directory, "frame-%06d.depth.png" % number)
+    if DEPTH_DIR:
+        depth_path = os.path.join(DEPTH_DIR, "frame-%06d.color.png" % number)
     depth = cv2.imread(depth_path, cv2.IMREAD_UNCHANGED)
     if depth is None or depth.dtype != np.uint16:
         fail(depth_path + ": missing or not a 16-bit depth image")
@@ -228,7 +235,7 @@ def find_cli(given):
 def score(cli, gt_path, est_path):
     metrics = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for key, extra in (("1", []), ("30", ["--rpe-delta", "30"])):
+        for key, extra in (("1", []), ("30", ["--rpe-delta", "30"]), ("sim3", ["--align", "sim3"])):
             out = os.path.join(tmp, "m.json")
             cmd = [cli, "eval", "--gt", gt_path, "--est", est_path, "--format", "tum",
                    "--align", "se3", "--json", out] + extra
@@ -240,6 +247,7 @@ def score(cli, gt_path, est_path):
     return {
         "ate_rmse": metrics["1"]["ape"]["rmse"],
         "ate_max": metrics["1"]["ape"]["max"],
+        "ate_sim3_rmse": metrics["sim3"]["ape"]["rmse"],
         "rpe1_trans_rmse": metrics["1"]["rpe_trans"]["rmse"],
         # None when the sequence is shorter than 30 frames (no pairs).
         "rpe30_trans_rmse": (metrics["30"]["rpe_trans"]["rmse"]
@@ -263,10 +271,17 @@ def main():
     parser.add_argument("--extra", action="append", default=[], metavar="NAME=FILE",
                         help="an extra TUM trajectory to score in the same table (repeatable)")
     parser.add_argument("--json", help="also write the table as JSON here")
+    parser.add_argument("--depth-dir", help="depth maps to use instead of the sensor's "
+                        "(`ademono infer` cache: DIR/frame-XXXXXX.color.png, 16-bit mm)")
     parser.add_argument("--reuse", action="store_true",
                         help="re-score trajectories already in --out from an identical run "
                              "(same sequence, frames, stride) instead of recomputing them")
     args = parser.parse_args()
+    global DEPTH_DIR
+    if args.depth_dir:
+        if not os.path.isdir(args.depth_dir):
+            fail(args.depth_dir + ": --depth-dir is not a folder")
+        DEPTH_DIR = args.depth_dir
 
     cv2.setNumThreads(int(os.environ["OMP_NUM_THREADS"]))
     methods = [m for m in args.methods.split(",") if m]
@@ -299,7 +314,7 @@ def main():
         path = os.path.join(args.out, name + ".txt")
         sidecar = os.path.join(args.out, name + ".run.json")
         run_key = {"sequence": os.path.abspath(args.sequence), "frames": len(frames),
-                   "stride": args.stride}
+                   "stride": args.stride, "depth_dir": os.path.abspath(args.depth_dir or "")}
         cached = None
         if args.reuse and os.path.exists(path) and os.path.exists(sidecar):
             with open(sidecar) as f:
@@ -326,15 +341,16 @@ def main():
     print("sequence: %s, %d frames (stride %d), APE after SE(3) alignment" %
           (args.sequence, len(frames), args.stride))
     print()
-    print("| method | ATE rmse (m) | ATE max (m) | RPE 1 frame rmse (m) | RPE 30 frames rmse (m) "
-          "| RPE 30 frames rot rmse (deg) | matched | CPU ms/frame | failed pairs |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| method | ATE rmse (m) | ATE sim3 rmse (m) | ATE max (m) | RPE 1 frame rmse (m) "
+          "| RPE 30 frames rmse (m) | RPE 30 frames rot rmse (deg) | matched | CPU ms/frame "
+          "| failed pairs |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     def fmt(value, spec):
         return "-" if value is None else spec % value
 
     for r in rows:
-        print("| %s | %.4f | %.4f | %.4f | %s | %s | %d | %s | %s |" % (
-            r["method"], r["ate_rmse"], r["ate_max"], r["rpe1_trans_rmse"],
+        print("| %s | %.4f | %.4f | %.4f | %.4f | %s | %s | %d | %s | %s |" % (
+            r["method"], r["ate_rmse"], r["ate_sim3_rmse"], r["ate_max"], r["rpe1_trans_rmse"],
             fmt(r["rpe30_trans_rmse"], "%.4f"), fmt(r["rpe30_rot_rmse_deg"], "%.3f"), r["matched"],
             "-" if r["ms_per_frame"] is None else "%.1f" % r["ms_per_frame"],
             "-" if r["failures"] is None else str(r["failures"])))

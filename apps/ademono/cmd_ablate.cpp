@@ -59,7 +59,7 @@ int Ablate(const AblateArgs& args) {
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
 
   const fs::path config_path = ResolveConfigPath(args.config, *sequence, args.depth);
-  const YAML::Node config = LoadConfig(config_path);
+  const YAML::Node config = LoadConfig(config_path, args.set);
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options.system);

@@ -30,6 +30,9 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
                "compute depth/detections sequentially (no prefetch)");
   app.add_option("--viz", args.viz, "write per-frame images with filter labels into DIR");
   app.add_option("--camera", args.camera, "camera YAML (overrides the dataset's)");
+  app.add_option("--set", args.set,
+                 "override a config key: SECTION.KEY=VALUE (repeatable), e.g. "
+                 "--set depth.scale_correction=false");
   app.add_option("--out", args.out, "output directory")->required();
 }
 
@@ -102,14 +105,31 @@ void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
   options.depth.error_per_metre = depth.error_model.per_metre;
 }
 
-YAML::Node LoadConfig(const fs::path& path) {
-  if (path.empty()) return YAML::Node();
-  RequireFile(path);
-  try {
-    return YAML::LoadFile(path.string());
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(path, std::string("invalid YAML: ") + e.msg);
+YAML::Node LoadConfig(const fs::path& path, const std::vector<std::string>& overrides) {
+  YAML::Node config;
+  if (!path.empty()) {
+    RequireFile(path);
+    try {
+      config = YAML::LoadFile(path.string());
+    } catch (const YAML::Exception& e) {
+      ThrowInputError(path, std::string("invalid YAML: ") + e.msg);
+    }
   }
+  static const std::regex pattern("^([A-Za-z_][A-Za-z0-9_]*)\\.([A-Za-z_][A-Za-z0-9_]*)=(.*)$");
+  for (const std::string& item : overrides) {
+    std::smatch m;
+    if (!std::regex_match(item, m, pattern)) {
+      throw InputError("--set '" + item + "': expected SECTION.KEY=VALUE (e.g. depth.max_depth=8)");
+    }
+    try {
+      const YAML::Node value = YAML::Load(m[3].str());
+      if (!config || !config.IsMap()) config = YAML::Node(YAML::NodeType::Map);
+      config[m[1].str()][m[2].str()] = value;
+    } catch (const YAML::Exception& e) {
+      throw InputError("--set '" + item + "': invalid YAML value: " + e.msg);
+    }
+  }
+  return config;
 }
 
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config, const fs::path& config_path) {

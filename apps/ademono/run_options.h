@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
@@ -28,6 +29,7 @@ struct SequenceRunArgs {
   std::string viz;
   std::string camera;
   std::string out;
+  std::vector<std::string> set;  // --set section.key=value overrides of the config
 };
 // --dataset --config --depth --detector --frames --seed --no-overlap --viz --camera --out.
 void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args);
@@ -47,7 +49,10 @@ std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Seq
 // settings that treat depth as a prior (a network settings family).
 void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options);
 // The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
-YAML::Node LoadConfig(const std::filesystem::path& path);
+// `overrides` ("section.key=value", value in YAML) replace keys of the file; the strict option
+// readers then reject unknown ones as they would in the file.
+YAML::Node LoadConfig(const std::filesystem::path& path,
+                      const std::vector<std::string>& overrides = {});
 // The `detector:` node (DetectorOptions::FromYaml); InputError naming the file and the key.
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config,
                                           const std::filesystem::path& config_path);

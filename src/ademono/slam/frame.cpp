@@ -32,9 +32,11 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        std::vector<cv::KeyPoint> keypoints,
                                                        cv::Mat descriptors,
                                                        std::vector<float> depth,
-                                                       const DepthErrorModel& depth_error) {
+                                                       const DepthErrorModel& depth_error,
+                                                       bool weight_by_error_model) {
   auto f = std::make_shared<FrameFeatures>();
   f->depth_error = depth_error;
+  f->weight_by_error_model = weight_by_error_model;
   f->camera = camera;
   f->pyramid = std::move(pyramid);
   f->intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy, virtual_baseline * camera.fx};
@@ -134,7 +136,7 @@ ImageObservation FrameFeatures::Observation(size_t i) const {
   o.pixel = Eigen::Vector2d(keypoints_un[i].pt.x, keypoints_un[i].pt.y);
   o.u_right = u_right[i];
   o.inv_sigma2 = pyramid->inv_level_sigma2[keypoints_un[i].octave];
-  if (depth_error.Enabled() && depth[i] > 0) {
+  if (depth_error.Enabled() && weight_by_error_model && depth[i] > 0) {
     // sigma(u_right) = bf * sigma_z / z^2 for u_right = u - bf / z.
     const double z = depth[i];
     o.depth_inv_sigma = z * z / (intrinsics.bf * depth_error.Sigma(z));

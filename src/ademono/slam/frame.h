@@ -45,6 +45,7 @@ struct FrameFeatures {
   std::vector<float> u_right;                        // u - bf / depth, < 0 when unknown
   // Error model of `depth` (disabled for sensor depth); scaled with the depths it describes.
   DepthErrorModel depth_error;
+  bool weight_by_error_model = true;  // false: the virtual baseline's weighting (ablation)
   float depth_scale = 1.f;  // factor applied to the source's depths (network scale correction)
   std::vector<std::vector<size_t>> grid;  // kGridCols * kGridRows cells of keypoint indices
 
@@ -71,7 +72,8 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        std::vector<cv::KeyPoint> keypoints,
                                                        cv::Mat descriptors,
                                                        std::vector<float> depth,
-                                                       const DepthErrorModel& depth_error = {});
+                                                       const DepthErrorModel& depth_error = {},
+                                                       bool weight_by_error_model = true);
 
 // The same features with every depth multiplied by `scale` (u_right recomputed, depth_scale
 // accumulated): the per-frame scale correction of network depth.

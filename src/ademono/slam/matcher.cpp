@@ -242,7 +242,7 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
       const float ex = u - kp.pt.x, ey = v - kp.pt.y;
       float e2 = ex * ex + ey * ey;
       double th = kChi2Mono;
-      if (f.DepthIsPrior()) {
+      if (f.DepthIsPrior() && f.weight_by_error_model) {
         // Network depth: weigh the depth disagreement by its error model, as the optimisers do.
         const ImageObservation obs = f.Observation(idx);
         double chi2 = e2 * obs.inv_sigma2;

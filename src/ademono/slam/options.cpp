@@ -27,6 +27,7 @@ const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
                                 .Add("edge_relative_jump", &D::edge_relative_jump, Range::Above(0))
                                 .Add("error_relative", &D::error_relative, Range::AtLeast(0))
                                 .Add("error_per_metre", &D::error_per_metre, Range::AtLeast(0))
+                                .Add("uncertainty_weighting", &D::uncertainty_weighting)
                                 .Add("scale_correction", &D::scale_correction)
                                 .Add("scale_min_points", &D::scale_min_points, Range::AtLeast(3))
                                 .Add("anchor_scale", &D::anchor_scale)

@@ -43,6 +43,9 @@ struct FrameDepthOptions {
   // the virtual baseline's pixel sigma (a model spec's `uncertainty:` overrides these two).
   double error_relative = 0.0;
   double error_per_metre = 0.0;
+  // false: depth residuals keep the virtual baseline's pixel weighting even with an error model
+  // (the ablation of uncertainty weighting; scale correction and the rest stay on).
+  bool uncertainty_weighting = true;
   // Each frame's depths are multiplied by the robust ratio of its tracked map points' depths to
   // its own (network scale wanders from frame to frame) before they seed points or enter
   // optimisation; at least scale_min_points pairs are needed.

@@ -167,7 +167,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   auto features =
       MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
                         options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths,
-                        options_.depth.ErrorModel());
+                        options_.depth.ErrorModel(), options_.depth.uncertainty_weighting);
   // Map points are culled when they keep landing in dynamic boxes; only boxes the filter found
   // to hold a moving object count, so a static person's (or parked car's) points survive.
   std::vector<Detection> moving_detections;
