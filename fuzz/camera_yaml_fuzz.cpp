@@ -9,8 +9,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::ExpectOnlyInputError([&] {
     const Camera camera = LoadCameraYaml(file);
     const Eigen::Vector2d corner(camera.width - 1.0, camera.height - 1.0);
-    static volatile double sink;
-    sink = camera.Undistort(corner).x() + camera.Unproject(corner, 1.0).z();
+    fuzz::g_sink = camera.Undistort(corner).x() + camera.Unproject(corner, 1.0).z();
   });
   return 0;
 }

@@ -21,6 +21,9 @@
 
 namespace ademono::fuzz {
 
+// Results are stored here so the optimiser cannot drop the calls that compute them.
+inline volatile double g_sink = 0;
+
 class ScratchDir {
  public:
   ScratchDir() {
@@ -122,8 +125,7 @@ void TouchSequence(const SequencePtr& sequence) {
   double sum = 0.0;
   for (size_t i = 0; i < sequence->Size(); ++i) sum += sequence->Timestamp(i);
   sum += sequence->GetCamera().fx;
-  static volatile double sink;
-  sink = sum;
+  g_sink = sum;
 }
 
 }  // namespace ademono::fuzz

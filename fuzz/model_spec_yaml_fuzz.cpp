@@ -12,8 +12,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     cv::Size input, content;
     spec.InputGeometry(cv::Size(640, 480), &input, &content);
     spec.InputGeometry(cv::Size(1241, 376), &input, &content);
-    static volatile double sink;
-    sink = spec.ToDepth(0.5, 1.0) + input.area() + content.area();
+    fuzz::g_sink = spec.ToDepth(0.5, 1.0) + input.area() + content.area();
   });
   return 0;
 }

@@ -1,6 +1,7 @@
 #include "ademono/core/camera.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
@@ -22,6 +23,14 @@ void Camera::Check() const {
     throw std::invalid_argument("camera fx and fy must be finite and > 0");
   if (!std::isfinite(cx) || !std::isfinite(cy))
     throw std::invalid_argument("camera cx and cy must be finite");
+  // A principal point off the image means the calibration belongs to other images (another
+  // resolution or crop); tracking would run, but with every ray wrong.
+  if (cx < 0 || cx > width || cy < 0 || cy > height) {
+    std::ostringstream message;
+    message << "camera principal point (" << cx << ", " << cy << ") is outside the image ("
+            << width << "x" << height << ")";
+    throw std::invalid_argument(message.str());
+  }
   for (double d : distortion)
     if (!std::isfinite(d)) throw std::invalid_argument("camera distortion must be finite");
 }
