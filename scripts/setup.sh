@@ -74,6 +74,8 @@ if [ "$do_build" = 1 ]; then
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   extra=()
+  # Timing a sanitized build means nothing: no benchmarks there.
+  [ "$sanitize" = ON ] && extra=(-DADEMONO_BUILD_BENCHMARKS=OFF)
   if [ "$tsan" = ON ]; then
     extra=(-DADEMONO_TSAN=ON -DADEMONO_BUILD_BENCHMARKS=OFF)
     [ ${#targets[@]} -gt 0 ] || targets=(--target test_slam)
