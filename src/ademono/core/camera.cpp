@@ -105,6 +105,8 @@ Camera Camera::Scaled(double sx, double sy) const {
 }
 
 namespace {
+constexpr int kMaxCameraSide = 100000;
+
 double RequireNumber(const YAML::Node& node, const char* key, const std::filesystem::path& path) {
   if (!node[key]) ThrowInputError(path, std::string("camera field '") + key + "' is missing");
   try {
@@ -115,14 +117,27 @@ double RequireNumber(const YAML::Node& node, const char* key, const std::filesys
     ThrowInputError(path, std::string("camera field '") + key + "' is not a number");
   }
 }
+
+// Image sizes are whole pixels; the bound keeps the int conversion defined (`width: 1e300`).
+int RequireSize(const YAML::Node& node, const char* key, const std::filesystem::path& path) {
+  const double v = RequireNumber(node, key, path);
+  if (!(v >= 1 && v <= kMaxCameraSide) || v != std::floor(v)) {
+    ThrowInputError(path, std::string("camera field '") + key +
+                              "' must be a whole number from 1 to " +
+                              std::to_string(kMaxCameraSide));
+  }
+  return static_cast<int>(v);
+}
 }  // namespace
 
 Camera ParseCameraNode(const YAML::Node& root, const std::filesystem::path& path) {
+  // Indexing a scalar or list root throws a yaml-cpp exception, not InputError (found by fuzzing).
+  if (!root.IsMap()) ThrowInputError(path, "camera YAML must be a mapping");
   const YAML::Node node = root["camera"] ? root["camera"] : root;
   if (!node.IsMap()) ThrowInputError(path, "camera YAML must be a mapping");
   Camera c;
-  c.width = static_cast<int>(RequireNumber(node, "width", path));
-  c.height = static_cast<int>(RequireNumber(node, "height", path));
+  c.width = RequireSize(node, "width", path);
+  c.height = RequireSize(node, "height", path);
   c.fx = RequireNumber(node, "fx", path);
   c.fy = RequireNumber(node, "fy", path);
   c.cx = RequireNumber(node, "cx", path);
