@@ -57,10 +57,11 @@ int Ablate(const AblateArgs& args) {
   if (!args.camera.empty()) camera_yaml = args.camera;
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
 
-  const fs::path config_path = ResolveConfigPath(args.config, *sequence);
+  const fs::path config_path = ResolveConfigPath(args.config, *sequence, args.depth);
   const YAML::Node config = LoadConfig(config_path);
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
+  ApplyDepthSource(args.depth, options.system);
   options.variants = variants;
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.system.filter.seed = ParseSeed(args.seed);

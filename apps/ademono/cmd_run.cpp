@@ -107,9 +107,10 @@ int Run(const RunArgs& args) {
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
 
   // Config: --config or the dataset family's default.
-  const fs::path config_path = ResolveConfigPath(args.config, *sequence);
+  const fs::path config_path = ResolveConfigPath(args.config, *sequence, args.depth);
   const YAML::Node config = LoadConfig(config_path);
   SystemOptions options = SystemOptions::FromYaml(config, config_path);
+  ApplyDepthSource(args.depth, options);
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.filter.seed = ParseSeed(args.seed);
   if (args.no_enhancement) options.filter.enable_enhancement = false;

@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "ademono/core/error.h"
+#include "ademono/depth/depth_factory.h"
 
 namespace fs = std::filesystem;
 
@@ -69,14 +70,36 @@ std::string DefaultConfigName(const std::string& kind, const std::string& path) 
   return kind + ".yaml";
 }
 
-fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence) {
-  if (!config_arg.empty()) return config_arg;
+fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence,
+                           const std::string& depth_arg) {
+  if (!config_arg.empty()) {
+    spdlog::info("config: {} (--config)", config_arg);
+    return config_arg;
+  }
   const fs::path dir = FindConfigDir();
-  const fs::path candidate = dir / DefaultConfigName(sequence.Kind(), sequence.Path().string());
-  if (!dir.empty() && fs::exists(candidate)) return candidate;
+  const DepthSourceInfo depth = DescribeDepthSource(depth_arg);
+  std::string name = DefaultConfigName(sequence.Kind(), sequence.Path().string());
+  std::string why = "the " + sequence.Kind() + " dataset family";
+  if (depth.network) {
+    const bool outdoor = depth.domain == "outdoor" || (depth.domain.empty() && sequence.Kind() == "kitti");
+    name = outdoor ? "network_outdoor.yaml" : "network_indoor.yaml";
+    why = std::string("depth from a network, ") + (outdoor ? "outdoor" : "indoor");
+  }
+  const fs::path candidate = dir / name;
+  if (!dir.empty() && fs::exists(candidate)) {
+    spdlog::info("config: {} ({})", candidate.string(), why);
+    return candidate;
+  }
   spdlog::warn("no config for '{}' found ({}); using built-in defaults", sequence.Kind(),
                candidate.string());
   return {};
+}
+
+void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
+  const DepthSourceInfo depth = DescribeDepthSource(depth_arg);
+  if (!depth.network || !depth.error_model.Enabled() || !options.depth.IsPrior()) return;
+  options.depth.error_relative = depth.error_model.relative;
+  options.depth.error_per_metre = depth.error_model.per_metre;
 }
 
 YAML::Node LoadConfig(const fs::path& path) {

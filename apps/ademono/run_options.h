@@ -11,6 +11,7 @@
 
 #include "ademono/detect/detector_factory.h"
 #include "ademono/io/sequence.h"
+#include "ademono/slam/options.h"
 
 namespace ademono::cli {
 
@@ -38,7 +39,13 @@ std::filesystem::path FindConfigDir();
 // sequence number (00-02, 03, 04-12), else <kind>.yaml.
 std::string DefaultConfigName(const std::string& kind, const std::string& path);
 // `config_arg` if given, else the family's file; empty (with a warning) when there is none.
-std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence);
+// Depth from a network (`depth_arg` model:...) picks network_indoor.yaml, or
+// network_outdoor.yaml for a spec with `domain: outdoor` or a KITTI dataset. Logs the choice.
+std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence,
+                                        const std::string& depth_arg = "");
+// A network model's spec with an `uncertainty:` error model sets the depth error model of
+// settings that treat depth as a prior (a network settings family).
+void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options);
 // The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
 YAML::Node LoadConfig(const std::filesystem::path& path);
 // The `detector:` node's score_threshold and nms_iou, checked.

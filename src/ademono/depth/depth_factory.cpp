@@ -30,4 +30,10 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
                    "' (expected sensor, cache:DIR, simulated[:k=v,...] or model:FILE.onnx)");
 }
 
+DepthSourceInfo DescribeDepthSource(const std::string& spec) {
+  const size_t colon = spec.find(':');
+  if (spec.substr(0, colon) != "model") return {};
+  return DescribeModelDepth(colon == std::string::npos ? "" : spec.substr(colon + 1));
+}
+
 }  // namespace ademono

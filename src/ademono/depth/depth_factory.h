@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "ademono/core/depth_error.h"
 #include "ademono/depth/depth_provider.h"
 #include "ademono/io/sequence.h"
 
@@ -24,5 +25,14 @@ struct DepthFactoryContext {
 
 std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
                                                  const DepthFactoryContext& context);
+
+// What a depth spec is, before any provider is built: `run` picks its settings family from it
+// (network depth gets configs/network_<domain>.yaml) and takes a model's error model.
+struct DepthSourceInfo {
+  bool network = false;        // a learned network (model:...), a prior rather than a sensor
+  std::string domain;          // the model spec's "indoor" / "outdoor", "" if it says nothing
+  DepthErrorModel error_model;  // the model spec's uncertainty (disabled if none)
+};
+DepthSourceInfo DescribeDepthSource(const std::string& spec);
 
 }  // namespace ademono

@@ -88,8 +88,17 @@ DepthModelSpec DepthModelSpec::FromYaml(const YAML::Node& node, const std::files
   DepthModelSpec spec;
   if (!node || !node.IsMap()) ThrowInputError(path, "model spec must be a YAML mapping");
   try {
-    CheckYamlKeys(node, "spec", {"name", "input", "output"});
+    CheckYamlKeys(node, "spec", {"name", "input", "output", "domain", "uncertainty"});
     spec.name = ReadYamlKey(node, "spec", "name", spec.name);
+    spec.domain = ReadYamlChoice<std::string>(
+        node, "spec", "domain", {{"indoor", "indoor"}, {"outdoor", "outdoor"}}, "");
+    const YAML::Node uncertainty = node["uncertainty"];
+    CheckSectionKeys(uncertainty, "uncertainty", {"relative", "per_metre"});
+    spec.uncertainty.relative = ReadYamlKey(uncertainty, "uncertainty", "relative", 0.0);
+    spec.uncertainty.per_metre = ReadYamlKey(uncertainty, "uncertainty", "per_metre", 0.0);
+    if (spec.uncertainty.relative < 0 || spec.uncertainty.per_metre < 0) {
+      throw std::invalid_argument("uncertainty: relative and per_metre must be >= 0");
+    }
     const YAML::Node in = node["input"];
     CheckSectionKeys(in, "input",
                      {"resize", "width", "height", "side", "side_length", "multiple_of", "pad",

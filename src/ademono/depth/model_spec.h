@@ -36,6 +36,12 @@
 //     min_depth: 0.0       # depths outside [min_depth, max_depth] become 0 (invalid)
 //     max_depth: 80.0
 //
+//   domain: indoor         # indoor | outdoor: which network settings family `run` picks
+//                          # (configs/network_indoor.yaml or network_outdoor.yaml)
+//   uncertainty:           # the model's depth error model, sigma_z = z * (relative +
+//     relative: 0.5        # per_metre * z), used to weigh depth in optimisation (replaces
+//     per_metre: 0.0       # the network config's depth.error_relative / error_per_metre)
+//
 // Output: 1x1xhxw, 1xhxw or hxw. When h x w differs from the input it is taken to cover the
 // same field (half-resolution outputs); the padding is cropped away, then the map is resized
 // bilinearly to the image.
@@ -46,6 +52,7 @@
 #include <filesystem>
 #include <string>
 
+#include "ademono/core/depth_error.h"
 #include "ademono/dnn/preprocess.h"
 
 namespace ademono {
@@ -76,6 +83,9 @@ struct DepthModelSpec {
   double canonical_focal = 0.0;
   double min_depth = 0.0;
   double max_depth = 1000.0;
+
+  std::string domain;             // "indoor", "outdoor" or "" (unknown)
+  DepthErrorModel uncertainty;    // disabled when the spec gives none
 
   // Throws std::invalid_argument naming the first bad field.
   void Check() const;

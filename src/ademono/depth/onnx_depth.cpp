@@ -26,16 +26,33 @@ bool CoversTheInput(int64_t in_h, int64_t in_w, int64_t out_h, int64_t out_w) {
 }
 
 }  // namespace
+std::optional<std::filesystem::path> FindModelSpecFile(
+    const std::filesystem::path& model_path, const std::optional<std::filesystem::path>& given) {
+  if (given) return given;
+  auto sibling = model_path;
+  sibling.replace_extension(".yaml");
+  if (std::filesystem::is_regular_file(sibling)) return sibling;
+  return std::nullopt;
+}
+
+DepthSourceInfo DescribeModelDepth(const std::string& argument) {
+  const ModelArg model = ParseModelArg(argument, {"spec"});
+  std::optional<std::filesystem::path> spec;
+  if (auto it = model.options.find("spec"); it != model.options.end()) spec = it->second;
+  DepthSourceInfo info;
+  info.network = true;
+  if (const auto file = FindModelSpecFile(model.file, spec)) {
+    const DepthModelSpec loaded = DepthModelSpec::Load(*file);
+    info.domain = loaded.domain;
+    info.error_model = loaded.uncertainty;
+  }
+  return info;
+}
 
 OnnxDepthProvider::OnnxDepthProvider(const std::filesystem::path& model_path,
                                      const std::optional<std::filesystem::path>& spec_path,
                                      const OrtSessionOptions& session_options) {
-  std::optional<std::filesystem::path> spec_file = spec_path;
-  if (!spec_file) {
-    auto sibling = model_path;
-    sibling.replace_extension(".yaml");
-    if (std::filesystem::is_regular_file(sibling)) spec_file = sibling;
-  }
+  const std::optional<std::filesystem::path> spec_file = FindModelSpecFile(model_path, spec_path);
   if (spec_file) {
     spec_ = DepthModelSpec::Load(*spec_file);
     spec_source_ = spec_file->string();

@@ -49,6 +49,13 @@ cv::Mat DepthToMillimetres(const cv::Mat& depth_m);
 // invalid pixels black.
 cv::Mat ColouriseDepth(const cv::Mat& depth_m);
 
+// The spec file of a model: `given`, else `<model stem>.yaml` beside it if present.
+std::optional<std::filesystem::path> FindModelSpecFile(
+    const std::filesystem::path& model_path, const std::optional<std::filesystem::path>& given);
+// What the spec of `model:ARGUMENT` says of the depth (domain, error model), without loading the
+// network. InputError for a bad argument or spec.
+DepthSourceInfo DescribeModelDepth(const std::string& argument);
+
 // The `model:` branch of MakeDepthProvider: `argument` is "FILE.onnx[,spec=SPEC.yaml]".
 std::unique_ptr<DepthProvider> MakeOnnxDepthProvider(const std::string& argument,
                                                      const DepthFactoryContext& context);

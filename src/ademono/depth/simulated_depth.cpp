@@ -57,6 +57,9 @@ void SimulatedDepthOptions::Check() const {
   if (edge_blur < 0 || edge_blur > 50) throw std::invalid_argument("edge_blur must be in [0, 50]");
   if (!(invalid >= 0.0 && invalid < 1.0)) throw std::invalid_argument("invalid must be in [0, 1)");
   if (!(pixel >= 0.0 && pixel <= 1.0)) throw std::invalid_argument("pixel must be in [0, 1]");
+  if (!(jitter >= 0.0 && jitter <= 1.0)) throw std::invalid_argument("jitter must be in [0, 1]");
+  if (!(jitter_frames >= 1.0) || !std::isfinite(jitter_frames))
+    throw std::invalid_argument("jitter_frames must be >= 1");
 }
 
 SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
@@ -83,6 +86,10 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.invalid = ParseNumber(key, value);
     } else if (key == "pixel") {
       options.pixel = ParseNumber(key, value);
+    } else if (key == "jitter") {
+      options.jitter = ParseNumber(key, value);
+    } else if (key == "jitter_frames") {
+      options.jitter_frames = ParseNumber(key, value);
     } else if (key == "edge_blur" || key == "seed") {
       const double number = ParseNumber(key, value);
       if (number < 0 || number != std::floor(number) || number > 1.8e19)
@@ -99,7 +106,8 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.gt_dir = value;
     } else {
       BadSpec("unknown parameter '" + key +
-              "' (expected scale, a, b, pixel, edge_blur, invalid, seed, gt)");
+              "' (expected scale, a, b, pixel, edge_blur, invalid, jitter, jitter_frames, seed, "
+              "gt)");
     }
   }
   try {
@@ -132,6 +140,21 @@ cv::Mat SimulatedDepthProvider::Depth(const FrameData& frame, const Camera& came
   if (!frame.image.empty() && truth.size() != frame.image.size())
     throw InputError("frame '" + frame.name + "': depth size differs from the image size");
   return Degrade(truth, frame.index);
+}
+
+double SimulatedDepthProvider::FrameScale(size_t frame_index) const {
+  if (options_.jitter <= 0.0) return options_.scale;
+  // Periods and phases depend on the seed only, so the signal is a function of the frame index.
+  cv::RNG rng(Mix64(options_.seed ^ 0x5CA1E) | 1);
+  constexpr int kTerms = 8;
+  const double two_pi = 2.0 * 3.14159265358979323846;
+  double sum = 0.0;
+  for (int m = 0; m < kTerms; ++m) {
+    const double period = options_.jitter_frames * std::exp(rng.uniform(-0.7, 0.7));
+    const double phase = rng.uniform(0.0, two_pi);
+    sum += std::cos(two_pi * static_cast<double>(frame_index) / period + phase);
+  }
+  return options_.scale * std::exp(options_.jitter * std::sqrt(2.0 / kTerms) * sum);
 }
 
 cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_index) const {
@@ -187,6 +210,7 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
     hole_threshold = values[k];
   }
 
+  const double frame_scale = FrameScale(frame_index);
   const float smooth_weight = static_cast<float>(std::sqrt(1.0 - options_.pixel));
   const float pixel_weight = static_cast<float>(std::sqrt(options_.pixel));
   cv::Mat out(size, CV_32F);
@@ -205,7 +229,7 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
       }
       const double sigma = options_.a * z + options_.b * z * z;
       const double noisy =
-          options_.scale * (z_edge[u] + sigma * (smooth_weight * ns[u] + pixel_weight * np[u]));
+          frame_scale * (z_edge[u] + sigma * (smooth_weight * ns[u] + pixel_weight * np[u]));
       o[u] = noisy > 0.0 ? static_cast<float>(noisy) : 0.f;
     }
   }

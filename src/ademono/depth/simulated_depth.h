@@ -9,11 +9,16 @@
 //   correlated over tens of pixels);
 // - z_edge: ground truth with depth edges smeared: within `edge_blur` pixels of a depth
 //   discontinuity (local max/min > 1.1) the depth is the local mean of valid depths;
+// - jitter: a network's scale also wanders from frame to frame with the scene's content. With
+//   jitter > 0 the scale of frame k is scale * exp(jitter * J(k)), J a smooth zero-mean,
+//   unit-variance signal (a sum of 8 cosines with periods around `jitter_frames` frames and
+//   phases from the seed), the same for every pixel of the frame;
 // - a fraction `invalid` of the pixels, in blobs (the top of another smooth field, ~12 px
 //   correlation), and every pixel without ground truth is 0.
 // Deterministic per frame: the noise is drawn from (seed, frame index) only.
 //
-// Spec: simulated[:scale=1.05,a=0.01,b=0.001,pixel=0.1,edge_blur=3,invalid=0.02,seed=S,gt=DIR]
+// Spec: simulated[:scale=1.05,a=0.01,b=0.001,pixel=0.1,edge_blur=3,invalid=0.02,jitter=0,
+//                 jitter_frames=60,seed=S,gt=DIR]
 // (every key optional; seed defaults to the run's seed).
 
 #include <cstdint>
@@ -34,6 +39,8 @@ struct SimulatedDepthOptions {
   double pixel = 0.1;  // share of the noise variance that is per-pixel (the rest is smooth)
   int edge_blur = 3;   // pixels; 0 keeps edges sharp
   double invalid = 0.02;
+  double jitter = 0.0;          // log-scale standard deviation of the per-frame scale
+  double jitter_frames = 60.0;  // typical period of the scale's wandering, in frames
   uint64_t seed = 0;
   std::optional<std::filesystem::path> gt_dir;  // ground truth from a depth cache folder
 
@@ -53,6 +60,8 @@ class SimulatedDepthProvider : public DepthProvider {
   cv::Mat Depth(const FrameData& frame, const Camera& camera) override;
   // The degradation alone, for a given ground truth (CV_32FC1 metres) and frame index.
   cv::Mat Degrade(const cv::Mat& depth_m, size_t frame_index) const;
+  // The scale bias of frame `frame_index` (scale, times the jitter when it is on).
+  double FrameScale(size_t frame_index) const;
 
  private:
   SimulatedDepthOptions options_;

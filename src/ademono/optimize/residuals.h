@@ -39,7 +39,8 @@ struct ProjectionResidual {
         u(obs.pixel.x()),
         v(obs.pixel.y()),
         ur(obs.u_right),
-        scale(std::sqrt(obs.inv_sigma2)) {}
+        scale(std::sqrt(obs.inv_sigma2)),
+        depth_scale(std::sqrt(obs.DepthWeight2())) {}
 
   template <typename T>
   bool Compute(const T* camera, const T* point_world, T* residual) const {
@@ -56,12 +57,12 @@ struct ProjectionResidual {
     const T pv = T(k.fy) * p[1] * inv_z + T(k.cy);
     residual[0] = T(scale) * (pu - T(u));
     residual[1] = T(scale) * (pv - T(v));
-    if constexpr (kDim == 3) residual[2] = T(scale) * (pu - T(k.bf) * inv_z - T(ur));
+    if constexpr (kDim == 3) residual[2] = T(depth_scale) * (pu - T(k.bf) * inv_z - T(ur));
     return true;
   }
 
   PinholeIntrinsics k;
-  double u, v, ur, scale;
+  double u, v, ur, scale, depth_scale;
 };
 
 // Pose-only: the point is a constant.
@@ -102,7 +103,11 @@ inline double ObservationChi2(const PinholeIntrinsics& k, const ImageObservation
       (pu - obs.pixel.x()) * (pu - obs.pixel.x()) + (pv - obs.pixel.y()) * (pv - obs.pixel.y());
   if (obs.HasDepth()) {
     const double ur = pu - k.bf * inv_z;
-    chi2 += (ur - obs.u_right) * (ur - obs.u_right);
+    const double e2 = (ur - obs.u_right) * (ur - obs.u_right);
+    if (obs.depth_inv_sigma > 0.0) {
+      return chi2 * obs.inv_sigma2 + e2 * obs.depth_inv_sigma * obs.depth_inv_sigma;
+    }
+    chi2 += e2;
   }
   return chi2 * obs.inv_sigma2;
 }

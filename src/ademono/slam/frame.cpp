@@ -31,8 +31,10 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        double virtual_baseline, double close_depth,
                                                        std::vector<cv::KeyPoint> keypoints,
                                                        cv::Mat descriptors,
-                                                       std::vector<float> depth) {
+                                                       std::vector<float> depth,
+                                                       const DepthErrorModel& depth_error) {
   auto f = std::make_shared<FrameFeatures>();
+  f->depth_error = depth_error;
   f->camera = camera;
   f->pyramid = std::move(pyramid);
   f->intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy, virtual_baseline * camera.fx};
@@ -91,6 +93,18 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
   return f;
 }
 
+std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale) {
+  auto f = std::make_shared<FrameFeatures>(features);
+  f->depth_scale *= scale;
+  const double bf = f->intrinsics.bf;
+  for (size_t i = 0; i < f->Size(); ++i) {
+    if (!(f->depth[i] > 0)) continue;
+    f->depth[i] *= scale;
+    f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+  }
+  return f;
+}
+
 std::vector<size_t> FrameFeatures::FeaturesInArea(float u, float v, float r, int min_level,
                                                   int max_level) const {
   std::vector<size_t> result;
@@ -120,6 +134,11 @@ ImageObservation FrameFeatures::Observation(size_t i) const {
   o.pixel = Eigen::Vector2d(keypoints_un[i].pt.x, keypoints_un[i].pt.y);
   o.u_right = u_right[i];
   o.inv_sigma2 = pyramid->inv_level_sigma2[keypoints_un[i].octave];
+  if (depth_error.Enabled() && depth[i] > 0) {
+    // sigma(u_right) = bf * sigma_z / z^2 for u_right = u - bf / z.
+    const double z = depth[i];
+    o.depth_inv_sigma = z * z / (intrinsics.bf * depth_error.Sigma(z));
+  }
   return o;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ademono/core/camera.h"
+#include "ademono/core/depth_error.h"
 #include "ademono/core/geometry.h"
 #include "ademono/optimize/optimizer_types.h"
 
@@ -42,6 +43,9 @@ struct FrameFeatures {
   cv::Mat descriptors;                               // CV_8UC1, 32 bytes per row
   std::vector<float> depth;                          // metres, <= 0 when unknown
   std::vector<float> u_right;                        // u - bf / depth, < 0 when unknown
+  // Error model of `depth` (disabled for sensor depth); scaled with the depths it describes.
+  DepthErrorModel depth_error;
+  float depth_scale = 1.f;  // factor applied to the source's depths (network scale correction)
   std::vector<std::vector<size_t>> grid;  // kGridCols * kGridRows cells of keypoint indices
 
   size_t Size() const { return keypoints.size(); }
@@ -56,6 +60,8 @@ struct FrameFeatures {
   // Camera-frame point of keypoint i from its depth (requires depth[i] > 0).
   Eigen::Vector3d UnprojectCamera(size_t i) const;
   bool IsClose(size_t i) const { return depth[i] > 0 && depth[i] < close_depth; }
+  // Whether depth is a prior with an error model (network) rather than a sensor reading.
+  bool DepthIsPrior() const { return depth_error.Enabled(); }
 };
 
 // Builds the features: undistorts keypoints, computes u_right and assigns the grid.
@@ -64,7 +70,12 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        double virtual_baseline, double close_depth,
                                                        std::vector<cv::KeyPoint> keypoints,
                                                        cv::Mat descriptors,
-                                                       std::vector<float> depth);
+                                                       std::vector<float> depth,
+                                                       const DepthErrorModel& depth_error = {});
+
+// The same features with every depth multiplied by `scale` (u_right recomputed, depth_scale
+// accumulated): the per-frame scale correction of network depth.
+std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale);
 
 // Where a map point is expected in a frame (filled by Frame::InFrustum for the local-map search).
 struct ProjectionPrediction {

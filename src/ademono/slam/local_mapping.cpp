@@ -1,9 +1,14 @@
 #include "ademono/slam/local_mapping.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "ademono/optimize/bundle_adjustment.h"
+#include "ademono/optimize/residuals.h"
+#include "ademono/optimize/triangulation.h"
 #include "ademono/slam/matcher.h"
 
 namespace ademono {
@@ -74,6 +79,10 @@ void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
     std::lock_guard<std::mutex> lock(map_.mutex);
     ProcessNewKeyFrame(*keyframe);
     CullMapPoints(*keyframe);
+    if (options_.triangulation) {
+      const int created = CreateNewMapPoints(*keyframe);
+      spdlog::debug("keyframe {}: {} map points triangulated", keyframe->id, created);
+    }
     FuseNeighbours(*keyframe);
   }
   // In threaded mode a waiting keyframe is more urgent than refining this one (as ORB-SLAM).
@@ -125,6 +134,83 @@ void LocalMapping::CullMapPoints(const KeyFrame& keyframe) {
     }
   }
   recent_points_ = std::move(kept);
+}
+
+int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
+  if (keyframe.bad) return 0;
+  const FrameFeatures& f1 = keyframe.F();
+  const PinholeIntrinsics& in = f1.intrinsics;
+  const double min_parallax_cos =
+      std::cos(options_.triangulation_min_parallax_deg * 3.14159265358979323846 / 180.0);
+  const float ratio_factor = 1.5f * f1.pyramid->scale_factors.at(std::min<size_t>(
+                                        1, f1.pyramid->scale_factors.size() - 1));
+  const Eigen::Vector3d center1 = keyframe.CameraCenter();
+  const Matcher matcher(0.6f, false);
+  int created = 0;
+  for (KeyFrame* k2 : keyframe.BestCovisibles(options_.triangulation_neighbours)) {
+    if (k2->bad) continue;
+    // Too short a baseline for the scene's depth: triangulation would be noise.
+    std::vector<double> depths;
+    for (const auto& p : k2->map_points) {
+      if (p && !p->bad) depths.push_back((k2->cam_from_world * p->position).z());
+    }
+    if (depths.empty()) continue;
+    std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+    const double median_depth = depths[depths.size() / 2];
+    const double baseline = (k2->CameraCenter() - center1).norm();
+    if (!(median_depth > 0) || baseline / median_depth < 0.01) continue;
+
+    std::vector<std::pair<size_t, size_t>> matches;
+    matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches);
+    const FrameFeatures& f2 = k2->F();
+    const Eigen::Vector3d center2 = k2->CameraCenter();
+    for (const auto& [i1, i2] : matches) {
+      if (keyframe.map_points[i1] || k2->map_points[i2]) continue;
+      const cv::KeyPoint& kp1 = f1.keypoints_un[i1];
+      const cv::KeyPoint& kp2 = f2.keypoints_un[i2];
+      const Eigen::Vector2d n1((kp1.pt.x - in.cx) / in.fx, (kp1.pt.y - in.cy) / in.fy);
+      const Eigen::Vector2d n2((kp2.pt.x - f2.intrinsics.cx) / f2.intrinsics.fx,
+                               (kp2.pt.y - f2.intrinsics.cy) / f2.intrinsics.fy);
+      const auto x = TriangulatePoint(keyframe.cam_from_world, k2->cam_from_world, n1, n2);
+      if (!x) continue;
+      if (ParallaxCosine(keyframe.cam_from_world, k2->cam_from_world, *x) > min_parallax_cos)
+        continue;
+      // In front of both cameras and reprojecting within chi2 (2 dof) at each keypoint's level.
+      ImageObservation o1, o2;
+      o1.pixel = Eigen::Vector2d(kp1.pt.x, kp1.pt.y);
+      o1.inv_sigma2 = f1.pyramid->inv_level_sigma2[kp1.octave];
+      o2.pixel = Eigen::Vector2d(kp2.pt.x, kp2.pt.y);
+      o2.inv_sigma2 = f2.pyramid->inv_level_sigma2[kp2.octave];
+      double z1 = 0, z2 = 0;
+      if (internal::ObservationChi2(in, o1, keyframe.cam_from_world, *x, &z1) > kChi2Mono ||
+          internal::ObservationChi2(f2.intrinsics, o2, k2->cam_from_world, *x, &z2) > kChi2Mono ||
+          z1 <= 0 || z2 <= 0)
+        continue;
+      // Scale consistency: the distances must agree with the keypoints' pyramid levels.
+      const double dist1 = (*x - center1).norm(), dist2 = (*x - center2).norm();
+      if (dist1 <= 0 || dist2 <= 0) continue;
+      const float ratio_dist = static_cast<float>(dist2 / dist1);
+      const float ratio_octave =
+          f1.pyramid->scale_factors[kp1.octave] / f2.pyramid->scale_factors[kp2.octave];
+      if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor)
+        continue;
+      // A depth prior that disagrees by more than its own uncertainty: a wrong match.
+      const double sigmas = options_.triangulation_depth_sigmas;
+      if (sigmas > 0 && f1.DepthIsPrior() && f1.depth[i1] > 0 &&
+          std::abs(z1 - f1.depth[i1]) > sigmas * f1.depth_error.Sigma(f1.depth[i1]))
+        continue;
+      auto point = map_.CreateMapPoint(*x, &keyframe, keyframe.frame_id);
+      point->AddObservation(&keyframe, i1);
+      point->AddObservation(k2, i2);
+      keyframe.AddMapPoint(point, i1);
+      k2->AddMapPoint(point, i2);
+      point->ComputeDistinctiveDescriptor();
+      point->UpdateNormalAndDepth();
+      recent_points_.push_back(point);
+      ++created;
+    }
+  }
+  return created;
 }
 
 void LocalMapping::FuseNeighbours(KeyFrame& keyframe) {

@@ -42,6 +42,8 @@ class LocalMapping {
   void Process(const std::shared_ptr<KeyFrame>& keyframe);
   void ProcessNewKeyFrame(KeyFrame& keyframe);
   void CullMapPoints(const KeyFrame& keyframe);
+  // Triangulates new map points with the best covisible keyframes; returns how many.
+  int CreateNewMapPoints(KeyFrame& keyframe);
   void FuseNeighbours(KeyFrame& keyframe);
   void LocalBundleAdjustment(KeyFrame& keyframe);
   void CullKeyFrames(KeyFrame& keyframe);

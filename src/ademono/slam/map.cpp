@@ -130,4 +130,20 @@ Rigid3d Map::ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyfr
   return cam_from_kf * keyframe->cam_from_world;
 }
 
+void Map::Rescale(double factor) {
+  auto rescale_keyframe = [factor](KeyFrame& kf) {
+    kf.cam_from_world.translation() *= factor;
+    kf.cam_from_parent.translation() *= factor;
+    if (kf.F().DepthIsPrior()) kf.features = RescaleDepth(kf.F(), static_cast<float>(factor));
+  };
+  for (auto& [id, kf] : keyframes_) rescale_keyframe(*kf);
+  for (auto& kf : graveyard_) rescale_keyframe(*kf);
+  const float f = static_cast<float>(factor);
+  for (auto& [id, p] : points_) {
+    p->position *= factor;
+    p->min_distance *= f;
+    p->max_distance *= f;
+  }
+}
+
 }  // namespace ademono

@@ -34,6 +34,9 @@ class Map {
   // re-parents its children in the spanning tree. The first keyframe is never removed.
   void EraseKeyFrame(KeyFrame* keyframe);
 
+  // Scales the world about its origin: point positions, keyframe translations (culled ones
+  // too) and keyframe depths (network depth priors) are multiplied by `factor`.
+  void Rescale(double factor);
   std::shared_ptr<KeyFrame> GetKeyFrame(uint64_t id) const;
   std::shared_ptr<MapPoint> GetMapPoint(uint64_t id) const;
   const std::map<uint64_t, std::shared_ptr<KeyFrame>>& KeyFrames() const { return keyframes_; }

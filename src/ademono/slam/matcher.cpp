@@ -297,12 +297,24 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
       const float ex = u - kp.pt.x, ey = v - kp.pt.y;
       float e2 = ex * ex + ey * ey;
       double th = kChi2Mono;
-      if (f.u_right[idx] >= 0) {
-        const float er = ur - f.u_right[idx];
-        e2 += er * er;
-        th = kChi2Stereo;
+      if (f.DepthIsPrior()) {
+        // Network depth: weigh the depth disagreement by its error model, as the optimisers do.
+        const ImageObservation obs = f.Observation(idx);
+        double chi2 = e2 * obs.inv_sigma2;
+        if (obs.HasDepth()) {
+          const double er = ur - obs.u_right;
+          chi2 += er * er * obs.DepthWeight2();
+          th = kChi2Stereo;
+        }
+        if (chi2 > th) continue;
+      } else {
+        if (f.u_right[idx] >= 0) {
+          const float er = ur - f.u_right[idx];
+          e2 += er * er;
+          th = kChi2Stereo;
+        }
+        if (e2 * f.pyramid->inv_level_sigma2[kp.octave] > th) continue;
       }
-      if (e2 * f.pyramid->inv_level_sigma2[kp.octave] > th) continue;
       const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
       if (d < best_dist) {
         best_dist = d;
@@ -324,6 +336,113 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
     ++fused;
   }
   return fused;
+}
+
+int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
+                                    std::vector<std::pair<size_t, size_t>>& matches) const {
+  const FrameFeatures& f1 = k1.F();
+  const FrameFeatures& f2 = k2.F();
+  const PinholeIntrinsics& in1 = f1.intrinsics;
+  const PinholeIntrinsics& in2 = f2.intrinsics;
+  const Rigid3d cam2_from_cam1 = k2.cam_from_world * k1.cam_from_world.inverse();
+  const Eigen::Matrix3d R = cam2_from_cam1.linear();
+  const Eigen::Vector3d t = cam2_from_cam1.translation();
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  Eigen::Matrix3d K1inv = Eigen::Matrix3d::Identity(), K2inv = Eigen::Matrix3d::Identity();
+  K1inv(0, 0) = 1.0 / in1.fx;
+  K1inv(1, 1) = 1.0 / in1.fy;
+  K1inv(0, 2) = -in1.cx / in1.fx;
+  K1inv(1, 2) = -in1.cy / in1.fy;
+  K2inv(0, 0) = 1.0 / in2.fx;
+  K2inv(1, 1) = 1.0 / in2.fy;
+  K2inv(0, 2) = -in2.cx / in2.fx;
+  K2inv(1, 2) = -in2.cy / in2.fy;
+  // x2^T F21 x1 = 0 for pixels of the same point.
+  const Eigen::Matrix3d F21 = K2inv.transpose() * tx * R * K1inv;
+
+  std::vector<size_t> free2;
+  for (size_t j = 0; j < f2.Size(); ++j) {
+    if (!k2.map_points[j] || k2.map_points[j]->bad) free2.push_back(j);
+  }
+  auto project2 = [&](const Eigen::Vector3d& p_cam2, Eigen::Vector2d* uv) {
+    if (p_cam2.z() <= 1e-6) return false;
+    *uv = Eigen::Vector2d(in2.fx * p_cam2.x() / p_cam2.z() + in2.cx,
+                          in2.fy * p_cam2.y() / p_cam2.z() + in2.cy);
+    return true;
+  };
+
+  std::vector<int> best1_for2(f2.Size(), -1), dist_for2(f2.Size(), 256);
+  for (size_t i = 0; i < f1.Size(); ++i) {
+    if (k1.map_points[i] && !k1.map_points[i]->bad) continue;
+    const cv::KeyPoint& kp1 = f1.keypoints_un[i];
+    const Eigen::Vector3d x1(kp1.pt.x, kp1.pt.y, 1.0);
+    const Eigen::Vector3d line = F21 * x1;
+    const double line_norm2 = line.x() * line.x() + line.y() * line.y();
+    if (!(line_norm2 > 0)) continue;
+    // The depth prior bounds where on the line the match can be.
+    bool segment = false;
+    Eigen::Vector2d seg_a, seg_b;
+    if (depth_sigmas > 0 && f1.depth[i] > 0 && f1.DepthIsPrior()) {
+      const double z = f1.depth[i];
+      const double sigma = f1.depth_error.Sigma(z);
+      const double z_near = std::max(0.05, z - depth_sigmas * sigma);
+      const double z_far = z + depth_sigmas * sigma;
+      const Eigen::Vector3d ray = K1inv * x1;
+      segment = project2(cam2_from_cam1 * (z_near * ray), &seg_a) &&
+                project2(cam2_from_cam1 * (z_far * ray), &seg_b);
+    }
+    const cv::Mat d1 = f1.descriptors.row(static_cast<int>(i));
+    int best = 256, second = 256;
+    size_t best_j = 0;
+    for (size_t j : free2) {
+      const cv::KeyPoint& kp2 = f2.keypoints_un[j];
+      const double e = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
+      const double sigma2 = f2.pyramid->level_sigma2[kp2.octave];
+      if (e * e / line_norm2 >= 3.84 * sigma2) continue;
+      if (segment) {
+        const Eigen::Vector2d ab = seg_b - seg_a;
+        const double len2 = ab.squaredNorm();
+        const Eigen::Vector2d x2(kp2.pt.x, kp2.pt.y);
+        const double s = len2 > 0 ? (x2 - seg_a).dot(ab) / len2 : 0.0;
+        const double margin = 2.0 * std::sqrt(sigma2) / std::sqrt(std::max(len2, 1e-9));
+        if (s < -margin || s > 1.0 + margin) continue;
+      }
+      const int d = DescriptorDistance(d1, f2.descriptors.row(static_cast<int>(j)));
+      if (d > kThLow) continue;
+      if (d < best) {
+        second = best;
+        best = d;
+        best_j = j;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best > kThLow || static_cast<float>(best) > nn_ratio_ * static_cast<float>(second)) continue;
+    if (best < dist_for2[best_j]) {
+      dist_for2[best_j] = best;
+      best1_for2[best_j] = static_cast<int>(i);
+    }
+  }
+  std::vector<std::pair<size_t, float>> rotations;
+  std::vector<std::pair<size_t, size_t>> found;
+  for (size_t j = 0; j < f2.Size(); ++j) {
+    if (best1_for2[j] < 0) continue;
+    const size_t i = static_cast<size_t>(best1_for2[j]);
+    rotations.emplace_back(found.size(), AngleDiff(f1.keypoints[i].angle, f2.keypoints[j].angle));
+    found.emplace_back(i, j);
+  }
+  std::vector<bool> drop(found.size(), false);
+  if (check_orientation_) {
+    for (size_t k : RotationOutliers(rotations)) drop[k] = true;
+  }
+  int n = 0;
+  for (size_t k = 0; k < found.size(); ++k) {
+    if (drop[k]) continue;
+    matches.push_back(found[k]);
+    ++n;
+  }
+  return n;
 }
 
 }  // namespace ademono

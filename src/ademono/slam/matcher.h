@@ -47,6 +47,15 @@ class Matcher {
   int Fuse(Map& map, KeyFrame& keyframe, const std::vector<std::shared_ptr<MapPoint>>& points,
            float radius) const;
 
+  // Triangulation (ORB-SLAM's SearchForTriangulation without a vocabulary): keypoints of `k1` and
+  // `k2` that have no map point yet, matched by descriptor (best below kThLow, ratio test,
+  // rotation check) among the candidates within the epipolar band of k2 (chi2 3.84 at the
+  // candidate's level). A k1 keypoint with a depth prior only searches the part of its epipolar
+  // line within `depth_sigmas` sigma of that depth (the whole line without one). Appends
+  // (k1 index, k2 index) pairs, each k2 keypoint at most once, and returns their number.
+  int SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
+                             std::vector<std::pair<size_t, size_t>>& matches) const;
+
   static float RadiusByViewingCos(float view_cos) { return view_cos > 0.998f ? 2.5f : 4.0f; }
 
  private:

@@ -21,12 +21,18 @@ void FrameDepthOptions::Check() const {
   Require(close_depth_factor > 0, "depth: close_depth_factor must be > 0");
   Require(edge_radius >= 0 && edge_radius <= 10, "depth: edge_radius must be in [0, 10]");
   Require(edge_relative_jump > 0, "depth: edge_relative_jump must be > 0");
+  Require(error_relative >= 0 && error_per_metre >= 0,
+          "depth: error_relative and error_per_metre must be >= 0");
+  Require(scale_min_points >= 3, "depth: scale_min_points must be >= 3");
+  Require(anchor_tolerance >= 0, "depth: anchor_tolerance must be >= 0");
+  Require(edge_relative_slope >= 0, "depth: edge_relative_slope must be >= 0");
 }
 
 FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
   CheckYamlKeys(node, "depth",
                 {"min_depth", "max_depth", "virtual_baseline", "close_depth_factor", "edge_radius",
-                 "edge_relative_jump"});
+                 "edge_relative_jump", "error_relative", "error_per_metre", "scale_correction",
+                 "scale_min_points", "anchor_scale", "anchor_tolerance", "edge_relative_slope"});
   FrameDepthOptions o;
   o.min_depth = ReadYamlKey(node, "depth", "min_depth", o.min_depth);
   o.max_depth = ReadYamlKey(node, "depth", "max_depth", o.max_depth);
@@ -34,6 +40,14 @@ FrameDepthOptions FrameDepthOptions::FromYaml(const YAML::Node& node) {
   o.close_depth_factor = ReadYamlKey(node, "depth", "close_depth_factor", o.close_depth_factor);
   o.edge_radius = ReadYamlKey(node, "depth", "edge_radius", o.edge_radius);
   o.edge_relative_jump = ReadYamlKey(node, "depth", "edge_relative_jump", o.edge_relative_jump);
+  o.error_relative = ReadYamlKey(node, "depth", "error_relative", o.error_relative);
+  o.error_per_metre = ReadYamlKey(node, "depth", "error_per_metre", o.error_per_metre);
+  o.scale_correction = ReadYamlKey(node, "depth", "scale_correction", o.scale_correction);
+  o.scale_min_points = ReadYamlKey(node, "depth", "scale_min_points", o.scale_min_points);
+  o.anchor_scale = ReadYamlKey(node, "depth", "anchor_scale", o.anchor_scale);
+  o.anchor_tolerance = ReadYamlKey(node, "depth", "anchor_tolerance", o.anchor_tolerance);
+  o.edge_relative_slope =
+      ReadYamlKey(node, "depth", "edge_relative_slope", o.edge_relative_slope);
   o.Check();
   return o;
 }
@@ -108,6 +122,10 @@ void MappingOptions::Check() const {
   Require(fuse_neighbours >= 0 && fuse_radius > 0, "mapping: fuse settings must be positive");
   Require(redundant_ratio > 0 && redundant_ratio <= 1, "mapping: redundant_ratio in (0, 1]");
   Require(redundant_observers >= 1, "mapping: redundant_observers must be >= 1");
+  Require(triangulation_neighbours >= 1, "mapping: triangulation_neighbours must be >= 1");
+  Require(triangulation_min_parallax_deg >= 0 && triangulation_min_parallax_deg < 90,
+          "mapping: triangulation_min_parallax_deg in [0, 90)");
+  Require(triangulation_depth_sigmas >= 0, "mapping: triangulation_depth_sigmas must be >= 0");
   ba.Check();
 }
 
@@ -115,7 +133,9 @@ MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
   CheckYamlKeys(node, "mapping",
                 {"deterministic", "local_ba", "cull_found_ratio", "cull_min_observations",
                  "fuse_neighbours", "fuse_radius", "ba_max_keyframes", "redundant_ratio",
-                 "redundant_observers", "ba_first_iterations", "ba_second_iterations"});
+                 "redundant_observers", "ba_first_iterations", "ba_second_iterations",
+                 "triangulation", "triangulation_neighbours", "triangulation_min_parallax_deg",
+                 "triangulation_depth_sigmas"});
   MappingOptions o;
   o.deterministic = ReadYamlKey(node, "mapping", "deterministic", o.deterministic);
   o.local_ba = ReadYamlKey(node, "mapping", "local_ba", o.local_ba);
@@ -128,6 +148,13 @@ MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
   o.redundant_ratio = ReadYamlKey(node, "mapping", "redundant_ratio", o.redundant_ratio);
   o.redundant_observers =
       ReadYamlKey(node, "mapping", "redundant_observers", o.redundant_observers);
+  o.triangulation = ReadYamlKey(node, "mapping", "triangulation", o.triangulation);
+  o.triangulation_neighbours =
+      ReadYamlKey(node, "mapping", "triangulation_neighbours", o.triangulation_neighbours);
+  o.triangulation_min_parallax_deg = ReadYamlKey(node, "mapping", "triangulation_min_parallax_deg",
+                                                 o.triangulation_min_parallax_deg);
+  o.triangulation_depth_sigmas =
+      ReadYamlKey(node, "mapping", "triangulation_depth_sigmas", o.triangulation_depth_sigmas);
   o.ba.first_iterations =
       ReadYamlKey(node, "mapping", "ba_first_iterations", o.ba.first_iterations);
   o.ba.second_iterations =

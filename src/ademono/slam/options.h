@@ -11,6 +11,7 @@
 
 #include <filesystem>
 
+#include "ademono/core/depth_error.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/optimize/bundle_adjustment.h"
@@ -29,6 +30,26 @@ struct FrameDepthOptions {
   // unregistered depth (7-Scenes, raw Kinect), where edges are shifted against the colour image.
   int edge_radius = 2;  // 0 disables the test
   double edge_relative_jump = 0.05;
+  // Network depth (a prior, not a sensor). error_relative > 0 switches it on:
+  // sigma_z = z * (error_relative + error_per_metre * z) weighs every depth residual instead of
+  // the virtual baseline's pixel sigma (a model spec's `uncertainty:` overrides these two).
+  double error_relative = 0.0;
+  double error_per_metre = 0.0;
+  // Each frame's depths are multiplied by the robust ratio of its tracked map points' depths to
+  // its own (network scale wanders from frame to frame) before they seed points or enter
+  // optimisation; at least scale_min_points pairs are needed.
+  bool scale_correction = true;
+  int scale_min_points = 20;
+  // The map's scale follows the long-run average of the network's, not its first frame: when the
+  // mean log correction drifts beyond anchor_tolerance, map and trajectory are rescaled.
+  bool anchor_scale = true;
+  double anchor_tolerance = 0.01;
+  // Smooth network depth: a keypoint whose depth changes by more than this fraction over
+  // edge_radius pixels sits on a blurred object boundary and gets no depth (0 disables). Replaces
+  // the hole / range test of sensor depth when the error model is on.
+  double edge_relative_slope = 0.0;
+  DepthErrorModel ErrorModel() const { return {error_relative, error_per_metre}; }
+  bool IsPrior() const { return ErrorModel().Enabled(); }
   double CloseDepth() const { return close_depth_factor * virtual_baseline; }
   void Check() const;  // throws std::invalid_argument
   static FrameDepthOptions FromYaml(const YAML::Node& node);
@@ -69,6 +90,14 @@ struct MappingOptions {
   double fuse_radius = 3;          // px at level 0
   double redundant_ratio = 0.9;    // keyframe culled when this fraction of its points ...
   int redundant_observers = 3;     // ... is seen by this many other keyframes
+  // Structure from geometry: keypoints of a new keyframe without a map point are matched along
+  // epipolar lines with its best covisible keyframes and triangulated (ORB-SLAM's
+  // CreateNewMapPoints), so points without usable depth still enter the map. A keypoint with a
+  // depth prior only searches within triangulation_depth_sigmas of it.
+  bool triangulation = false;
+  int triangulation_neighbours = 10;
+  double triangulation_min_parallax_deg = 1.0;
+  double triangulation_depth_sigmas = 3.0;
   BundleAdjustmentOptions ba;
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);

@@ -47,6 +47,22 @@ std::vector<float> System::KeypointDepths(const std::vector<cv::KeyPoint>& keypo
     if (x < 0 || y < 0 || x >= depth.cols || y >= depth.rows) continue;
     const float z = depth.at<float>(y, x);
     if (!std::isfinite(z) || z < options.min_depth || z > options.max_depth) continue;
+    if (options.IsPrior()) {
+      // Smooth network depth has no holes and blurs object boundaries into ramps: drop depth
+      // where it changes steeply across the keypoint (it is neither object nor background).
+      if (r > 0 && options.edge_relative_slope > 0) {
+        auto at = [&](int xx, int yy) {
+          xx = std::clamp(xx, 0, depth.cols - 1);
+          yy = std::clamp(yy, 0, depth.rows - 1);
+          return depth.at<float>(yy, xx);
+        };
+        const float dx = std::abs(at(x + r, y) - at(x - r, y));
+        const float dy = std::abs(at(x, y + r) - at(x, y - r));
+        if (!(std::max(dx, dy) <= options.edge_relative_slope * z)) continue;
+      }
+      result[i] = z;
+      continue;
+    }
     if (r > 0) {
       // Depth at an object boundary is unreliable (and, unregistered, may belong to the other
       // side): require a locally consistent neighbourhood.
@@ -156,7 +172,8 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   start = std::chrono::steady_clock::now();
   auto features =
       MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
-                        options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths);
+                        options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths,
+                        options_.depth.ErrorModel());
   // Map points are culled when they keep landing in dynamic boxes; only boxes the filter found
   // to hold a moving object count, so a static person's (or parked car's) points survive.
   std::vector<Detection> moving_detections;
@@ -203,6 +220,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.tracked = out.tracked;
   result.inliers = out.inliers;
   result.dynamic_points_culled = out.dynamic_points_culled;
+  result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
 
   if (out.new_keyframe) {
@@ -246,6 +264,15 @@ Trajectory System::FrameTrajectory() const {
     trajectory.push_back({r.timestamp, cam_from_world.inverse()});
   }
   return trajectory;
+}
+
+std::vector<std::pair<size_t, double>> System::DepthScales() const {
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  std::vector<std::pair<size_t, double>> scales;
+  for (const FrameRecord& r : tracking_.Records()) {
+    if (r.tracked) scales.emplace_back(r.index, r.depth_scale);
+  }
+  return scales;
 }
 
 Trajectory System::KeyFrameTrajectory() const {

@@ -34,6 +34,7 @@ struct TrackResult {
   int num_with_depth = 0;  // kept keypoints with valid depth
   int inliers = 0;
   int dynamic_points_culled = 0;  // map points culled for sitting in dynamic boxes
+  double depth_scale = 1.0;       // network depth: this frame's scale correction
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)
@@ -57,6 +58,9 @@ class System {
   // Pose of every tracked input frame, resolved against the current keyframe poses.
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
+  // Network depth: the scale correction of every tracked frame (input index, factor), against
+  // the final map (anchoring rescales update it); 1 for sensor depth.
+  std::vector<std::pair<size_t, double>> DepthScales() const;
   struct ColoredPoint {
     Eigen::Vector3d position;
     cv::Vec3b bgr;

@@ -3,10 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <opencv2/calib3d.hpp>
 
 #include "ademono/core/cv_geometry.h"
+#include "ademono/optimize/depth_scale.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
 
@@ -30,6 +32,10 @@ int Tracking::CountDepthPoints(const Frame& frame) const {
 
 TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
                                double timestamp, const std::vector<Detection>& detections) {
+  // Network depth starts from the last frame's correction (its scale wanders slowly).
+  if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
+    features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));
+  }
   Frame frame(next_frame_id_++, index, timestamp, std::move(features));
   TrackingOutput out;
   bool ok = false;
@@ -67,7 +73,11 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       }
       state_ = TrackingState::kOk;
       lost_streak_ = 0;
-      if (NeedNewKeyFrame(frame)) out.new_keyframe = CreateNewKeyFrame(frame);
+      CorrectDepthScale(frame, true);
+      if (NeedNewKeyFrame(frame)) {
+        out.map_rescale = AnchorScale(frame);
+        out.new_keyframe = CreateNewKeyFrame(frame);
+      }
       // Outliers do not carry over to the next frame's motion-model search.
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
         if (frame.map_points[i] && frame.outlier[i]) frame.map_points[i].reset();
@@ -103,6 +113,12 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.tracked = true;
     out.cam_from_world = *frame.cam_from_world;
     out.inliers = matches_inliers_;
+    out.depth_scale = record.depth_scale = frame.F().depth_scale;
+    if (frame.F().DepthIsPrior()) {
+      last_depth_scale_ = frame.F().depth_scale;
+      log_scale_sum_ += std::log(last_depth_scale_);
+      ++log_scale_count_;
+    }
   } else if (state_ != TrackingState::kNotInitialized) {
     ++num_lost_;
   }
@@ -144,7 +160,57 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   return true;
 }
 
+void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
+  if (!frame.F().DepthIsPrior() || !options_.depth.scale_correction || !frame.cam_from_world) {
+    return;
+  }
+  const FrameFeatures& f = frame.F();
+  std::vector<double> map_depths, frame_depths;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad || !(f.depth[i] > 0) || (inliers_only && frame.outlier[i])) continue;
+    map_depths.push_back((*frame.cam_from_world * p->position).z());
+    frame_depths.push_back(f.depth[i]);
+  }
+  DepthScaleOptions options;
+  options.min_points = options_.depth.scale_min_points;
+  const DepthScaleEstimate estimate = EstimateDepthScale(map_depths, frame_depths, options);
+  if (!estimate.valid) return;
+  frame.features = RescaleDepth(f, static_cast<float>(estimate.scale));
+}
+
+double Tracking::AnchorScale(Frame& frame) {
+  if (!frame.F().DepthIsPrior() || !options_.depth.anchor_scale || log_scale_count_ == 0 ||
+      !local_mapping_.Idle()) {
+    return 1.0;
+  }
+  // This frame counts too (it is added to the sum after tracking).
+  const double mean = (log_scale_sum_ + std::log(frame.F().depth_scale)) / (log_scale_count_ + 1);
+  if (std::abs(mean) <= options_.depth.anchor_tolerance) return 1.0;
+  const double factor = std::exp(-mean);
+  RescaleWorld(frame, factor);
+  return factor;
+}
+
+void Tracking::RescaleWorld(Frame& frame, double factor) {
+  map_.Rescale(factor);
+  auto scale_translation = [factor](Rigid3d& pose) { pose.translation() *= factor; };
+  for (FrameRecord& r : records_) {
+    scale_translation(r.cam_from_reference);
+    r.depth_scale *= factor;
+  }
+  if (last_frame_ && last_frame_->cam_from_world) scale_translation(*last_frame_->cam_from_world);
+  if (velocity_) scale_translation(*velocity_);
+  if (last_good_pose_) scale_translation(*last_good_pose_);
+  scale_translation(*frame.cam_from_world);
+  frame.features = RescaleDepth(frame.F(), static_cast<float>(factor));
+  // The history is now measured against the rescaled map.
+  log_scale_sum_ += log_scale_count_ * std::log(factor);
+  last_depth_scale_ *= factor;
+}
+
 int Tracking::OptimizeFramePose(Frame& frame) {
+  CorrectDepthScale(frame, false);
   std::vector<PoseObservation> observations;
   std::vector<size_t> indices;
   const FrameFeatures& f = frame.F();

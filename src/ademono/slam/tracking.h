@@ -29,6 +29,7 @@ struct FrameRecord {
   bool tracked = false;
   KeyFrame* reference = nullptr;  // owned by the map (never freed while the map lives)
   Rigid3d cam_from_reference = Rigid3d::Identity();
+  double depth_scale = 1.0;  // network depth: the factor its depths were corrected by
 };
 
 struct TrackingOutput {
@@ -39,6 +40,8 @@ struct TrackingOutput {
   bool relocalised = false;
   bool reinitialised = false;
   int dynamic_points_culled = 0;
+  double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
+  double map_rescale = 1.0;  // != 1 when the map was rescaled to the network's long-run scale
 };
 
 class Tracking {
@@ -68,6 +71,13 @@ class Tracking {
   int DiscardOutliers(Frame& frame);
   void UpdateLocalMap(Frame& frame);
   int CountDepthPoints(const Frame& frame) const;
+  // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
+  // median of ratios); `inliers_only` after the pose is final.
+  void CorrectDepthScale(Frame& frame, bool inliers_only);
+  // Keeps the map at the network's long-run mean scale; returns the factor applied (1 if none).
+  double AnchorScale(Frame& frame);
+  // Multiplies every length of the map and of the tracker's state by `factor`.
+  void RescaleWorld(Frame& frame, double factor);
 
   Map& map_;
   const LocalMapping& local_mapping_;
@@ -84,6 +94,9 @@ class Tracking {
   int lost_streak_ = 0;
   int num_lost_ = 0;
   int num_relocalisations_ = 0;
+  double last_depth_scale_ = 1.0;  // the last tracked frame's network scale correction
+  double log_scale_sum_ = 0.0;     // sum of log(depth_scale) over tracked frames
+  int log_scale_count_ = 0;
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
   std::vector<FrameRecord> records_;
