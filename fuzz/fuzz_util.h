@@ -107,16 +107,18 @@ inline void WriteIfAny(const std::filesystem::path& path, std::string_view bytes
 namespace ademono::fuzz {
 
 // Places a small textured 64x48 8-bit PNG at `path` (the sequence openers read the first image's
-// size); encoded once per process and copied after.
+// size); encoded once per process. Written through WriteFile, whose stream retries writes cut by
+// libFuzzer's timer signal (std::filesystem::copy_file threw EINTR there).
 inline void WriteSmallImage(const std::filesystem::path& path, int channels) {
-  const auto cached = Scratch() / ("small_" + std::to_string(channels) + ".png");
-  if (!std::filesystem::exists(cached)) {
-    cv::Mat image(48, 64, channels == 1 ? CV_8UC1 : CV_8UC3);
+  static const auto encode = [](int c) {
+    cv::Mat image(48, 64, c == 1 ? CV_8UC1 : CV_8UC3);
     cv::randu(image, 0, 255);
-    if (!cv::imwrite(cached.string(), image)) std::abort();
-  }
-  std::filesystem::create_directories(path.parent_path());
-  std::filesystem::copy_file(cached, path, std::filesystem::copy_options::overwrite_existing);
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", image, png)) std::abort();
+    return std::string(png.begin(), png.end());
+  };
+  static const std::string grey = encode(1), colour = encode(3);
+  WriteFile(path, channels == 1 ? grey : colour);
 }
 
 // Calls Timestamp() on every frame and reads the camera: what a run does before decoding.
