@@ -17,6 +17,10 @@ function(ademono_add_test name)
     # ONNX Runtime leaks 14 bytes of its own at start-up; nothing of ademono's is suppressed.
     set(_env "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tools/lsan_onnxruntime.supp")
   endif()
+  if(ADEMONO_TSAN)
+    # Uninstrumented third-party thread pools only (see the file).
+    set(_env "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tools/tsan.supp")
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
     PROPERTIES TIMEOUT 900 ENVIRONMENT "${_env}")
 endfunction()

@@ -1,24 +1,36 @@
 #!/usr/bin/env bash
 # Installs what ademono needs on Debian 12, only what is missing, then configures and builds.
-# Usage: scripts/setup.sh [--build-type Release|Debug|RelWithDebInfo] [--sanitize] [--build-dir DIR] [--no-build]
+# Usage: scripts/setup.sh [--build-type Release|Debug|RelWithDebInfo] [--sanitize|--tsan|--fuzz]
+#                         [--build-dir DIR] [--no-build] [--target T]
 #   --sanitize: AddressSanitizer + UndefinedBehaviorSanitizer build (default dir build/asan)
+#   --tsan:     ThreadSanitizer build of the slam tests only (default dir build/tsan)
+#   --fuzz:     clang + libFuzzer targets of fuzz/ only (default dir build/fuzz; tools/fuzz.sh)
+#   --target:   build only this target (repeatable)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_type=Release
 build_dir=""
 do_build=1
 sanitize=OFF
+tsan=OFF
+fuzz=OFF
+targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-type) build_type="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --no-build) do_build=0; shift ;;
     --sanitize) sanitize=ON; shift ;;
+    --tsan) tsan=ON; shift ;;
+    --fuzz) fuzz=ON; shift ;;
+    --target) targets+=(--target "$2"); shift 2 ;;
     *) echo "setup.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 if [ -z "$build_dir" ]; then
   if [ "$sanitize" = ON ]; then build_dir="$here/build/asan"
+  elif [ "$tsan" = ON ]; then build_dir="$here/build/tsan"
+  elif [ "$fuzz" = ON ]; then build_dir="$here/build/fuzz"
   else build_dir="$here/build/$(echo "$build_type" | tr '[:upper:]' '[:lower:]')"; fi
 fi
 
@@ -29,6 +41,7 @@ apt_packages=(
   python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
   python3-dev pybind11-dev python3-matplotlib
   chromium
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${apt_packages[@]}"; do
@@ -85,7 +98,21 @@ fi
 if [ "$do_build" = 1 ]; then
   launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  extra=()
+  # Timing a sanitized build means nothing: no benchmarks there.
+  [ "$sanitize" = ON ] && extra=(-DADEMONO_BUILD_BENCHMARKS=OFF)
+  if [ "$tsan" = ON ]; then
+    extra=(-DADEMONO_TSAN=ON -DADEMONO_BUILD_BENCHMARKS=OFF)
+    [ ${#targets[@]} -gt 0 ] || targets=(--target test_slam)
+  fi
+  if [ "$fuzz" = ON ]; then
+    # libFuzzer comes with clang (libclang-rt-14-dev); -O2 -g for readable crash stacks.
+    [ "$build_type" = Release ] && build_type=RelWithDebInfo
+    extra=(-DCMAKE_CXX_COMPILER=clang++ -DADEMONO_FUZZ=ON -DADEMONO_BUILD_TESTS=OFF
+           -DADEMONO_BUILD_BENCHMARKS=OFF)
+    [ ${#targets[@]} -gt 0 ] || targets=(--target fuzz_all)
+  fi
   cmake -S "$here" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DADEMONO_SANITIZE="$sanitize" \
-    -DONNXRUNTIME_ROOT="$ort_root" "${launcher[@]}" >/dev/null
-  cmake --build "$build_dir" -j "$(nproc)"
+    -DONNXRUNTIME_ROOT="$ort_root" "${launcher[@]}" "${extra[@]}" >/dev/null
+  cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"
 fi

@@ -13,6 +13,11 @@ compare against hand-computed values:
   det_yolov8_probe.onnx 1x3x64x64 -> 1x5x1      one YOLOv8 box whose class-0 score is the mean of
                                                 input channel 0: checks colour order, /255 and
                                                 the letterbox padding value
+Models that must be rejected at load with one line naming the file (bad-input tests):
+  depth_uint8_input.onnx    uint8 1x3x48x64 -> float 1x1x48x64   input of the wrong type
+  depth_double_output.onnx  1x3x48x64 -> double 1x1x48x64        output of the wrong type
+  depth_opset99.onnx        depth_metric declaring ai.onnx opset 99 (no runtime has it)
+  det_double_output.onnx    det_yolov8 with a double output
 The detector heads ignore the image (0 * mean(input) is added so the input stays in the graph).
 
 Run with the system Python (python3-onnx): /usr/bin/python3 tools/make_test_models.py
@@ -27,23 +32,30 @@ OUT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"
 OPSET = 13
 
 
-def save(graph, name):
-    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)],
+def save(graph, name, opset=OPSET):
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", opset)],
                               producer_name="ademono make_test_models.py")
     model.ir_version = 7
-    onnx.checker.check_model(model)
+    if opset == OPSET:  # the checker itself rejects an unknown opset
+        onnx.checker.check_model(model)
     path = os.path.join(OUT_DIR, name)
     onnx.save(model, path)
     print(f"{path}: {os.path.getsize(path)} bytes")
 
 
-def image_input(height, width):
-    return helper.make_tensor_value_info("image", TensorProto.FLOAT, [1, 3, height, width])
+def image_input(height, width, element_type=TensorProto.FLOAT):
+    return helper.make_tensor_value_info("image", element_type, [1, 3, height, width])
 
 
 def channel_mean_model(name, out_shape, height=48, width=64, squeeze=False, pool=False,
-                       channels=1):
-    nodes = [helper.make_node("ReduceMean", ["image"], ["mean"], axes=[1], keepdims=1)]
+                       channels=1, input_type=TensorProto.FLOAT, output_type=TensorProto.FLOAT,
+                       opset=OPSET):
+    nodes = []
+    source = "image"
+    if input_type != TensorProto.FLOAT:
+        nodes.append(helper.make_node("Cast", ["image"], ["image_float"], to=TensorProto.FLOAT))
+        source = "image_float"
+    nodes.append(helper.make_node("ReduceMean", [source], ["mean"], axes=[1], keepdims=1))
     last = "mean"
     if pool:
         nodes.append(helper.make_node("AveragePool", [last], ["pooled"], kernel_shape=[2, 2],
@@ -57,13 +69,16 @@ def channel_mean_model(name, out_shape, height=48, width=64, squeeze=False, pool
         nodes.append(helper.make_node("Constant", [], ["axes"], value=axes))
         nodes.append(helper.make_node("Squeeze", [last, "axes"], ["squeezed"]))
         last = "squeezed"
-    nodes.append(helper.make_node("Identity", [last], ["depth"]))
-    graph = helper.make_graph(nodes, name, [image_input(height, width)],
-                              [helper.make_tensor_value_info("depth", TensorProto.FLOAT, out_shape)])
-    save(graph, name + ".onnx")
+    if output_type != TensorProto.FLOAT:
+        nodes.append(helper.make_node("Cast", [last], ["depth"], to=output_type))
+    else:
+        nodes.append(helper.make_node("Identity", [last], ["depth"]))
+    graph = helper.make_graph(nodes, name, [image_input(height, width, input_type)],
+                              [helper.make_tensor_value_info("depth", output_type, out_shape)])
+    save(graph, name + ".onnx", opset)
 
 
-def constant_head(name, values, out_name="output"):
+def constant_head(name, values, out_name="output", output_type=TensorProto.FLOAT):
     values = np.asarray(values, dtype=np.float32)
     nodes = [
         helper.make_node("Constant", [], ["head"], value=numpy_helper.from_array(values, "head")),
@@ -71,10 +86,14 @@ def constant_head(name, values, out_name="output"):
         helper.make_node("Constant", [], ["zero"],
                          value=numpy_helper.from_array(np.array(0, dtype=np.float32), "zero")),
         helper.make_node("Mul", ["image_mean", "zero"], ["nothing"]),
-        helper.make_node("Add", ["head", "nothing"], [out_name]),
     ]
+    if output_type != TensorProto.FLOAT:
+        nodes.append(helper.make_node("Add", ["head", "nothing"], ["sum"]))
+        nodes.append(helper.make_node("Cast", ["sum"], [out_name], to=output_type))
+    else:
+        nodes.append(helper.make_node("Add", ["head", "nothing"], [out_name]))
     graph = helper.make_graph(nodes, name, [image_input(64, 64)],
-                              [helper.make_tensor_value_info(out_name, TensorProto.FLOAT,
+                              [helper.make_tensor_value_info(out_name, output_type,
                                                              list(values.shape))])
     save(graph, name + ".onnx")
 
@@ -136,6 +155,12 @@ def main():
     v8 = [box + [obj * p for p in probs] for box, obj, probs in DET_BOXES]
     constant_head("det_yolov8", [np.asarray(v8).T.tolist()], out_name="output0")
     input_probe_head("det_yolov8_probe")
+
+    channel_mean_model("depth_uint8_input", [1, 1, 48, 64], input_type=TensorProto.UINT8)
+    channel_mean_model("depth_double_output", [1, 1, 48, 64], output_type=TensorProto.DOUBLE)
+    channel_mean_model("depth_opset99", [1, 1, 48, 64], opset=99)
+    constant_head("det_double_output", [np.asarray(v8).T.tolist()], out_name="output0",
+                  output_type=TensorProto.DOUBLE)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #include "ademono/core/camera.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
@@ -22,6 +23,14 @@ void Camera::Check() const {
     throw std::invalid_argument("camera fx and fy must be finite and > 0");
   if (!std::isfinite(cx) || !std::isfinite(cy))
     throw std::invalid_argument("camera cx and cy must be finite");
+  // A principal point off the image means the calibration belongs to other images (another
+  // resolution or crop); tracking would run, but with every ray wrong.
+  if (cx < 0 || cx > width || cy < 0 || cy > height) {
+    std::ostringstream message;
+    message << "camera principal point (" << cx << ", " << cy << ") is outside the image ("
+            << width << "x" << height << ")";
+    throw std::invalid_argument(message.str());
+  }
   for (double d : distortion)
     if (!std::isfinite(d)) throw std::invalid_argument("camera distortion must be finite");
 }
@@ -96,6 +105,8 @@ Camera Camera::Scaled(double sx, double sy) const {
 }
 
 namespace {
+constexpr int kMaxCameraSide = 100000;
+
 double RequireNumber(const YAML::Node& node, const char* key, const std::filesystem::path& path) {
   if (!node[key]) ThrowInputError(path, std::string("camera field '") + key + "' is missing");
   try {
@@ -106,14 +117,27 @@ double RequireNumber(const YAML::Node& node, const char* key, const std::filesys
     ThrowInputError(path, std::string("camera field '") + key + "' is not a number");
   }
 }
+
+// Image sizes are whole pixels; the bound keeps the int conversion defined (`width: 1e300`).
+int RequireSize(const YAML::Node& node, const char* key, const std::filesystem::path& path) {
+  const double v = RequireNumber(node, key, path);
+  if (!(v >= 1 && v <= kMaxCameraSide) || v != std::floor(v)) {
+    ThrowInputError(path, std::string("camera field '") + key +
+                              "' must be a whole number from 1 to " +
+                              std::to_string(kMaxCameraSide));
+  }
+  return static_cast<int>(v);
+}
 }  // namespace
 
 Camera ParseCameraNode(const YAML::Node& root, const std::filesystem::path& path) {
+  // Indexing a scalar or list root throws a yaml-cpp exception, not InputError (found by fuzzing).
+  if (!root.IsMap()) ThrowInputError(path, "camera YAML must be a mapping");
   const YAML::Node node = root["camera"] ? root["camera"] : root;
   if (!node.IsMap()) ThrowInputError(path, "camera YAML must be a mapping");
   Camera c;
-  c.width = static_cast<int>(RequireNumber(node, "width", path));
-  c.height = static_cast<int>(RequireNumber(node, "height", path));
+  c.width = RequireSize(node, "width", path);
+  c.height = RequireSize(node, "height", path);
   c.fx = RequireNumber(node, "fx", path);
   c.fy = RequireNumber(node, "fy", path);
   c.cx = RequireNumber(node, "cx", path);

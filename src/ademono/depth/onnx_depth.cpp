@@ -14,6 +14,18 @@
 
 namespace ademono {
 
+namespace {
+
+// A depth map covers the network input: its aspect ratio, at the input's resolution or a
+// fraction of it (10 % slack for rounding at odd sizes). Anything else, e.g. a detector's head
+// loaded as a depth model, is the wrong kind of model.
+bool CoversTheInput(int64_t in_h, int64_t in_w, int64_t out_h, int64_t out_w) {
+  const double sx = static_cast<double>(out_w) / static_cast<double>(in_w);
+  const double sy = static_cast<double>(out_h) / static_cast<double>(in_h);
+  return std::max(sx, sy) <= 1.1 * std::min(sx, sy);
+}
+
+}  // namespace
 std::optional<std::filesystem::path> FindModelSpecFile(
     const std::filesystem::path& model_path, const std::optional<std::filesystem::path>& given) {
   if (given) return given;
@@ -77,9 +89,13 @@ OnnxDepthProvider::OnnxDepthProvider(const std::filesystem::path& model_path,
   const std::string out_text = ShapeToString(out);
   bool out_ok = out.size() >= 2 && out.size() <= 4;
   for (size_t i = 0; out_ok && i + 2 < out.size(); ++i) out_ok = out[i] == 1 || out[i] == -1;
+  if (out_ok && fixed_size && out[out.size() - 2] > 0 && out[out.size() - 1] > 0) {
+    out_ok = CoversTheInput(in[2], in[3], out[out.size() - 2], out[out.size() - 1]);
+  }
   if (!out_ok) {
-    ThrowInputError(model_path, "depth model output must be 1x1xHxW, 1xHxW or HxW, the model has " +
-                                    out_text + " (input " + in_text + ")");
+    ThrowInputError(model_path,
+                    "depth model output must be 1x1xHxW, 1xHxW or HxW with the input's aspect "
+                    "ratio, the model has " + out_text + " (input " + in_text + ")");
   }
   if (session_->Outputs().size() > 1) {
     spdlog::debug("{}: using the first of {} outputs", model_path.string(),
@@ -123,6 +139,12 @@ cv::Mat OnnxDepthProvider::DepthFromImage(const cv::Mat& image, const Camera& ca
   if (static_cast<size_t>(out_h) * out_w != out.data.size()) {
     ThrowInputError(session_->Path(),
                     "output " + ShapeToString(out.shape) + " is not a single depth map");
+  }
+  if (!CoversTheInput(input_size.height, input_size.width, out_h, out_w)) {
+    ThrowInputError(session_->Path(), "output " + ShapeToString(out.shape) +
+                                          " does not have the aspect ratio of the input " +
+                                          std::to_string(input_size.width) + "x" +
+                                          std::to_string(input_size.height));
   }
   const cv::Mat raw(out_h, out_w, CV_32F, const_cast<float*>(out.data.data()));
   // The padding, in output pixels (outputs may be at a fraction of the input resolution).

@@ -3,6 +3,7 @@
 // truth mav0/state_groundtruth_estimate0/data.csv (world_from_body), interpolated at image times.
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "ademono/core/error.h"
@@ -36,6 +37,8 @@ struct EurocCamera {
   Rigid3d body_from_cam = Rigid3d::Identity();
 };
 
+EurocCamera ParseSensorYaml(const YAML::Node& root, const fs::path& path);
+
 EurocCamera ReadSensorYaml(const fs::path& path) {
   // EuRoC files start with OpenCV's "%YAML:1.0", which is not a YAML directive yaml-cpp accepts.
   std::string text = ReadTextFile(path);
@@ -46,6 +49,17 @@ EurocCamera ReadSensorYaml(const fs::path& path) {
   } catch (const YAML::ParserException& e) {
     ThrowInputError(path, static_cast<size_t>(e.mark.line + 1), "malformed YAML: " + e.msg);
   }
+  if (!root.IsMap()) ThrowInputError(path, "sensor.yaml must be a mapping");
+  // Fields of the wrong kind (a scalar where a map is expected, a list as distortion_model)
+  // throw yaml-cpp exceptions; they are bad input too (found by fuzz_sequence_euroc).
+  try {
+    return ParseSensorYaml(root, path);
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(path, "malformed sensor.yaml: " + e.msg);
+  }
+}
+
+EurocCamera ParseSensorYaml(const YAML::Node& root, const fs::path& path) {
   EurocCamera out;
   const auto intrinsics = ReadNumberList(root["intrinsics"], path, "intrinsics", 4);
   const auto resolution = ReadNumberList(root["resolution"], path, "resolution", 2);
@@ -53,6 +67,12 @@ EurocCamera ReadSensorYaml(const fs::path& path) {
   out.camera.fy = intrinsics[1];
   out.camera.cx = intrinsics[2];
   out.camera.cy = intrinsics[3];
+  for (const double side : {resolution[0], resolution[1]}) {
+    // Bounded before the int conversion, which is undefined for e.g. 1e300.
+    if (!(side >= 1 && side <= 100000)) {
+      ThrowInputError(path, "field 'resolution' must hold two sizes from 1 to 100000 pixels");
+    }
+  }
   out.camera.width = static_cast<int>(resolution[0]);
   out.camera.height = static_cast<int>(resolution[1]);
   if (root["distortion_coefficients"]) {
@@ -75,6 +95,9 @@ EurocCamera ReadSensorYaml(const fs::path& path) {
     if (data.size() != 16) ThrowInputError(path, "field 'T_BS.data' must hold 16 numbers");
     Eigen::Matrix4d m;
     for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = data[i];
+    if (!m.allFinite() || std::abs(m.topLeftCorner<3, 3>().determinant()) < 1e-6) {
+      ThrowInputError(path, "field 'T_BS.data': rotation part is singular or not finite");
+    }
     out.body_from_cam = MakeRigid3d(m);
   }
   return out;

@@ -2,6 +2,7 @@
 // established once at open by grabbing through the file, because container frame counts are
 // often wrong. Decoding is sequential: the capture is kept at the next frame so in-order Load()
 // costs one decode; going backwards reopens the file. A mutex serialises access to the capture.
+#include <cmath>
 #include <mutex>
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
@@ -22,9 +23,18 @@ class VideoSequence : public Sequence {
     Reopen();
     double fps = capture_.get(cv::CAP_PROP_FPS);
     if (!(fps > 0 && fps < 1000)) fps = 30.0;
+    const double declared = capture_.get(cv::CAP_PROP_FRAME_COUNT);
     size_t count = 0;
     while (capture_.grab()) ++count;
     if (count == 0) ThrowInputError(file_, "sequence has no frames");
+    // A declared count (exact in AVI/MP4 headers, at most one off when estimated) far above the
+    // frames that decode means a cut-off file or a corrupt frame: the run would silently stop
+    // there, so say so instead.
+    if (declared > 0 && static_cast<double>(count) + 1 < declared) {
+      ThrowInputError(file_, "frame " + std::to_string(count) + " does not decode, but the video "
+                             "declares " + std::to_string(std::llround(declared)) +
+                             " frames (cut off or corrupt)");
+    }
     for (size_t i = 0; i < count; ++i) timestamps_.push_back(static_cast<double>(i) / fps);
     Reopen();
   }

@@ -1,0 +1,88 @@
+#!/usr/bin/python3
+"""Writes the fuzz seed corpora into OUT/<target>/: small valid inputs in the formats of the test
+fixtures (tests/io, tests/detect, tests/depth) plus the repo's own configs and model specs.
+Multi-file targets (sequence_*) take their files joined by NUL bytes, in the order their
+fuzz/<name>_fuzz.cpp lists. Usage: fuzz/make_seeds.py OUT"""
+import glob
+import os
+import sys
+
+import cv2
+import numpy as np
+
+here = os.path.dirname(os.path.abspath(__file__))
+root = os.path.dirname(here)
+out = sys.argv[1]
+
+
+def seed(target, name, data):
+    d = os.path.join(out, target)
+    os.makedirs(d, exist_ok=True)
+    if isinstance(data, str):
+        data = data.encode()
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+
+
+def parts(*files):
+    return b"\0".join(f.encode() if isinstance(f, str) else f for f in files)
+
+
+tum = "# timestamp tx ty tz qx qy qz qw\n1.0 1 2 3 0 0 0 1\n1.1 1 2 3.1 0 0 0.0499792 0.99875\n"
+kitti = "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0.5 0 1 0 0 0 0 1 0.1\n"
+euroc = ("#timestamp,p_x,p_y,p_z,q_w,q_x,q_y,q_z\n"
+         "1403636579763555584,0,0,0,0.7071067811865476,0,0,0.7071067811865476\n"
+         "1403636579813555584,0,0.05,0,0.7071067811865476,0,0,0.7071067811865476,0,0,0\n")
+seed("trajectory_tum", "two_poses.txt", tum)
+seed("trajectory_kitti", "two_poses.txt", kitti)
+seed("trajectory_euroc", "two_poses.csv", euroc)
+
+rgb = "# color images\n100.0 rgb/0.png\n100.033 rgb/1.png\n"
+depth = "# depth maps\n100.001 depth/0.png\n100.034 depth/1.png\n"
+camera = "width: 32\nheight: 24\nfx: 30\nfy: 31\ncx: 16\ncy: 12\n"
+seed("sequence_tum", "full", parts(rgb, depth, tum.replace("1.0 ", "100.0 ").replace("1.1 ", "100.1 "), camera))
+seed("sequence_tum", "rgb_only", parts(rgb))
+seed("sequence_tum", "camera_node", parts(rgb, "", "", "camera:\n  " + camera.replace("\n", "\n  ")))
+
+calib = "P0: 700 0 32 0 0 701 24 0 0 0 1 0\nP1: 700 0 32 -386 0 701 24 0 0 0 1 0\n"
+seed("sequence_kitti", "full", parts(calib, "0.0\n0.1036\n", kitti))
+seed("sequence_kitti", "calib_only", parts(calib))
+
+data_csv = "#timestamp [ns],filename\n1403636579763555584,1403636579763555584.png\n" \
+           "1403636579813555584,1403636579813555584.png\n"
+sensor = ("%YAML:1.0\nsensor_type: camera\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0.1, "
+          "0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\nrate_hz: 20\nresolution: [32, 24]\n"
+          "camera_model: pinhole\nintrinsics: [458.654, 457.296, 16.0, 12.0]\n"
+          "distortion_model: radial-tangential\n"
+          "distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]\n")
+seed("sequence_euroc", "full", parts(data_csv, sensor, euroc))
+
+pose = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+seed("sequence_7scenes", "full", parts(pose, pose.replace("1 0 0 0\n", "1 0 0 0.1\n", 1),
+                                       "40 0 16\n0 41 12\n0 0 1\n"))
+
+seed("camera_yaml", "plain.yaml", camera)
+seed("camera_yaml", "node.yaml", "camera:\n  width: 640\n  height: 480\n  fx: 525\n  fy: 525\n"
+     "  cx: 319.5\n  cy: 239.5\n  distortion: [0.1, -0.2, 0.001, 0.002, 0.05]\n")
+
+for path in sorted(glob.glob(os.path.join(root, "configs", "*.yaml"))):
+    seed("system_options_yaml", os.path.basename(path), open(path, "rb").read())
+for path in sorted(glob.glob(os.path.join(root, "configs", "models", "*.yaml")) +
+                   glob.glob(os.path.join(root, "tests", "data", "models", "*.yaml"))):
+    seed("model_spec_yaml", os.path.basename(path), open(path, "rb").read())
+
+seed("detections_jsonl", "two_frames.jsonl",
+     '{"frame":0,"timestamp":0.0,"name":"0.000000","detections":[{"class_id":0,"class":"person",'
+     '"score":1.0,"box_xywh":[253.0,32.0,67.0,151.0]}]}\n'
+     '{"frame":1,"timestamp":0.033333,"name":"0.033333","detections":[]}\n')
+
+# depth_image: first byte picks the extension (even: .png, odd: .tiff).
+rng = np.random.default_rng(0)
+mm = rng.integers(0, 8000, size=(6, 8), dtype=np.uint16)
+mm[0, 0], mm[0, 1] = 0, 65535
+ok, png = cv2.imencode(".png", mm)
+seed("depth_image", "mm16.png", b"\0" + png.tobytes())
+metres = rng.uniform(0.2, 9.0, size=(6, 8)).astype(np.float32)
+metres[0, 0] = np.nan
+ok, tiff = cv2.imencode(".tiff", metres)
+seed("depth_image", "metres32.tiff", b"\1" + tiff.tobytes())

@@ -1,0 +1,105 @@
+// The threaded mapping path (`mapping.deterministic: false`, `ademono run --threaded`): local
+// mapping on its own thread while tracking goes on. Outputs are not bit-reproducible there, so
+// the tests bound accuracy and count tracked frames instead. Also built with -fsanitize=thread
+// (scripts/setup.sh --tsan) to check the map's locking.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <opencv2/core/utility.hpp>
+
+#include "ademono/depth/depth_factory.h"
+#include "ademono/detect/detector_factory.h"
+#include "ademono/eval/trajectory_eval.h"
+#include "ademono/io/sequence.h"
+#include "ademono/slam/pipeline.h"
+#include "ademono/slam/system.h"
+#include "ademono/synth/generator.h"
+
+namespace ademono {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 100 frames of the synthetic office (320x240, one walking person, exact depth), rendered once.
+class ThreadedMappingTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+#if defined(__SANITIZE_THREAD__)
+    // OpenCV's parallel_for_ runs on TBB workers, which are not instrumented: TSan cannot see
+    // their synchronisation and reports every pixel loop. Sequential OpenCV leaves exactly the
+    // threads under test: local mapping and the pipeline's prefetch.
+    cv::setNumThreads(0);
+#endif
+    dir_ = fs::temp_directory_path() / ("ademono_threaded_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    synth::GeneratorOptions options;
+    options.scene.scene = "office";
+    options.scene.frames = 100;
+    options.scene.seed = 3;
+    options.scene.width = 320;
+    options.scene.height = 240;
+    options.scene.persons = 1;
+    synth::GenerateSequence(options, dir_);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  struct Run {
+    Trajectory trajectory;
+    int tracked = 0, lost = 0;
+    size_t keyframes = 0, map_points = 0;
+  };
+
+  // Runs the sequence's first `frames` frames with exact depth and the ground-truth boxes.
+  static Run RunThreaded(size_t frames) {
+    const auto sequence = OpenSequence("tum:" + dir_.string());
+    DepthFactoryContext context;
+    context.sequence = sequence.get();
+    const auto depth = MakeDepthProvider("sensor", context);
+    const auto detector = MakeDetector("cache:" + (dir_ / "detections.jsonl").string(), {});
+    SystemOptions options;
+    options.mapping.deterministic = false;
+    System system(sequence->GetCamera(), options);
+    PipelineOptions pipeline;
+    pipeline.end = frames;
+    RunPipeline(*sequence, depth.get(), detector.get(), system, pipeline);
+    system.Shutdown();
+    return {system.FrameTrajectory(), system.NumTracked(), system.NumLost(),
+            system.NumKeyFrames(), system.NumMapPoints()};
+  }
+
+  static double AteSe3(const Trajectory& estimate) {
+    const Trajectory gt = ReadTumTrajectory(dir_ / "groundtruth.txt");
+    return EvaluateTrajectories(gt, estimate, EvalOptions{}).ape.rmse;
+  }
+
+  static inline fs::path dir_;
+};
+
+TEST_F(ThreadedMappingTest, TracksTheOfficeAccurately) {
+  const Run run = RunThreaded(100);
+  // Measured: 100/100 tracked, ATE 0.011 m (deterministic mode: same bound holds).
+  EXPECT_EQ(run.tracked, 100);
+  EXPECT_EQ(run.lost, 0);
+  ASSERT_EQ(run.trajectory.size(), 100u);
+  EXPECT_GE(run.keyframes, 5u);
+  EXPECT_GE(run.map_points, 200u);
+  EXPECT_LT(AteSe3(run.trajectory), 0.03);
+}
+
+TEST_F(ThreadedMappingTest, StopsCleanlyMidSequence) {
+  // Shutdown right after a burst of keyframes: queued keyframes are finished or dropped, the
+  // mapping thread joins, and what was tracked is still a usable trajectory.
+  const Run run = RunThreaded(25);
+  EXPECT_EQ(run.tracked, 25);
+  ASSERT_EQ(run.trajectory.size(), 25u);
+  EXPECT_GE(run.keyframes, 2u);
+  EXPECT_LT(AteSe3(run.trajectory), 0.03);
+}
+
+}  // namespace
+}  // namespace ademono
