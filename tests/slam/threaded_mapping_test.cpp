@@ -13,7 +13,7 @@
 #include "ademono/detect/detector_factory.h"
 #include "ademono/eval/trajectory_eval.h"
 #include "ademono/io/sequence.h"
-#include "ademono/slam/pipeline.h"
+#include "ademono/runner/pipeline.h"
 #include "ademono/slam/system.h"
 #include "ademono/synth/generator.h"
 
