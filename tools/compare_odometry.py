@@ -235,10 +235,11 @@ def find_cli(given):
 def score(cli, gt_path, est_path):
     metrics = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for key, extra in (("1", []), ("30", ["--rpe-delta", "30"]), ("sim3", ["--align", "sim3"])):
+        for key, align, extra in (("1", "se3", []), ("30", "se3", ["--rpe-delta", "30"]),
+                                  ("sim3", "sim3", [])):
             out = os.path.join(tmp, "m.json")
             cmd = [cli, "eval", "--gt", gt_path, "--est", est_path, "--format", "tum",
-                   "--align", "se3", "--json", out] + extra
+                   "--align", align, "--json", out] + extra
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if proc.returncode != 0:
                 fail(proc.stderr.strip() or "ademono eval failed on " + est_path)
