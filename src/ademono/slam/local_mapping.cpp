@@ -42,9 +42,11 @@ size_t LocalMapping::QueueSize() const {
   return queue_.size();
 }
 
-double LocalMapping::LastMilliseconds() const {
+double LocalMapping::TakeFinishedMilliseconds() {
   std::lock_guard<std::mutex> lock(queue_mutex_);
-  return last_ms_;
+  const double ms = finished_ms_;
+  finished_ms_ = 0;
+  return ms;
 }
 
 void LocalMapping::Shutdown() {
@@ -95,7 +97,7 @@ void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(queue_mutex_);
-  last_ms_ = ms;
+  finished_ms_ += ms;
 }
 
 void LocalMapping::ProcessNewKeyFrame(KeyFrame& keyframe) {
@@ -329,7 +331,6 @@ void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
   }
 
   const BundleAdjustmentResult result = SolveBundleAdjustment(problem, options_.ba);
-  ++num_ba_;
 
   std::lock_guard<std::mutex> lock(map_.mutex);
   for (size_t i = 0; i < problem.observations.size(); ++i) {

@@ -33,9 +33,9 @@ class LocalMapping {
   size_t QueueSize() const;
   // Blocks until the queue is empty (threaded mode), then stops the worker.
   void Shutdown();
-  // Wall time of the last processed keyframe (ms) and of all of them.
-  double LastMilliseconds() const;
-  int NumLocalBundleAdjustments() const { return num_ba_; }
+  // Wall time (ms) of the keyframes whose processing finished since the last call, each counted
+  // once: in threaded mode a frame reports the mapping work that completed while it was tracked.
+  double TakeFinishedMilliseconds();
 
  private:
   void Run();
@@ -57,8 +57,7 @@ class LocalMapping {
   std::deque<std::shared_ptr<KeyFrame>> queue_;
   bool busy_ = false;
   bool stop_ = false;
-  double last_ms_ = 0;
-  int num_ba_ = 0;
+  double finished_ms_ = 0;  // guarded by queue_mutex_
   std::thread worker_;
 };
 

@@ -221,7 +221,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
     local_mapping_.InsertKeyFrame(out.new_keyframe);
     result.mapping_ms = options_.mapping.deterministic ? MsSince(start) : 0.0;
   }
-  if (!options_.mapping.deterministic) result.mapping_ms = local_mapping_.LastMilliseconds();
+  if (!options_.mapping.deterministic) {
+    result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
+  }
 
   // What the dynamic filter needs of this frame next time.
   // All keypoints, not only the kept ones: a point on a moving person removed in this frame must
