@@ -185,9 +185,10 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   TrackingOutput out;
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
-    // With a depth map the occlusion-aware culling below replaces the tracker's box culling.
-    out = tracking_.Track(features, frame.index, frame.timestamp,
-                          depth.empty() ? moving_detections : std::vector<Detection>{});
+    out = tracking_.Track(features, frame.index, frame.timestamp);
+    // The one rule for map points on moving objects: occlusion-aware, so it needs this frame's
+    // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
+    // background the box covers).
     if (out.tracked && !depth.empty() && options_.filter.enable_dynamic_removal &&
         !moving_detections.empty())
       out.dynamic_points_culled +=

@@ -31,7 +31,7 @@ int Tracking::CountDepthPoints(const Frame& frame) const {
 }
 
 TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                               double timestamp, const std::vector<Detection>& detections) {
+                               double timestamp) {
   // Network depth starts from the last frame's correction (its scale wanders slowly).
   if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
     features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));
@@ -63,7 +63,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       out.relocalised = ok;
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (ok) ok = TrackLocalMap(frame, detections, &out.dynamic_points_culled);
+    if (ok) ok = TrackLocalMap(frame);
 
     if (ok) {
       if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
@@ -131,6 +131,17 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   return out;
 }
 
+void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
+                                    const Rigid3d& world_from_cam, size_t i) {
+  auto point = map_.CreateMapPoint(world_from_cam * frame.F().UnprojectCamera(i), &keyframe,
+                                   frame.id);
+  point->AddObservation(&keyframe, i);
+  keyframe.AddMapPoint(point, i);
+  point->ComputeDistinctiveDescriptor();
+  point->UpdateNormalAndDepth();
+  frame.map_points[i] = point;
+}
+
 bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   if (CountDepthPoints(frame) < options_.tracking.min_init_points) return false;
   frame.cam_from_world = cam_from_world;
@@ -139,12 +150,7 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (f.depth[i] <= 0) continue;
-    auto point = map_.CreateMapPoint(world_from_cam * f.UnprojectCamera(i), kf.get(), frame.id);
-    point->AddObservation(kf.get(), i);
-    kf->AddMapPoint(point, i);
-    point->ComputeDistinctiveDescriptor();
-    point->UpdateNormalAndDepth();
-    frame.map_points[i] = point;
+    CreatePointFromDepth(frame, *kf, world_from_cam, i);
   }
   frame.reference_keyframe = kf.get();
   reference_keyframe_ = kf.get();
@@ -321,7 +327,7 @@ void Tracking::UpdateLocalMap(Frame& frame) {
   }
 }
 
-bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detections, int* culled) {
+bool Tracking::TrackLocalMap(Frame& frame) {
   UpdateLocalMap(frame);
   // Points already matched are not searched again.
   for (auto& p : frame.map_points) {
@@ -343,24 +349,6 @@ bool Tracking::TrackLocalMap(Frame& frame, const std::vector<Detection>& detecti
     ++p->visible;
     candidates.push_back(p);
     predictions.push_back(prediction);
-  }
-  // Map points that keep projecting into boxes of dynamic objects are probably on them.
-  if (options_.filter.enable_dynamic_removal && !detections.empty()) {
-    const auto& classes = options_.filter.dynamic.dynamic_class_ids;
-    for (size_t k = 0; k < candidates.size(); ++k) {
-      for (const Detection& d : detections) {
-        if (!classes.empty() &&
-            std::find(classes.begin(), classes.end(), d.class_id) == classes.end())
-          continue;
-        if (d.box.contains(cv::Point2f(predictions[k].u, predictions[k].v))) {
-          if (++candidates[k]->dynamic_hits >= options_.tracking.dynamic_cull_hits) {
-            map_.ErasePoint(candidates[k].get());
-            ++*culled;
-          }
-          break;
-        }
-      }
-    }
   }
   const bool recently_relocalised = frame.id < last_reloc_frame_id_ + 2;
   const float radius = static_cast<float>(options_.tracking.local_search_radius) *
@@ -445,12 +433,7 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
   int considered = 0;
   for (const auto& [z, i] : by_depth) {
     if (!kf->map_points[i]) {
-      auto point = map_.CreateMapPoint(world_from_cam * f.UnprojectCamera(i), kf.get(), frame.id);
-      point->AddObservation(kf.get(), i);
-      kf->AddMapPoint(point, i);
-      point->ComputeDistinctiveDescriptor();
-      point->UpdateNormalAndDepth();
-      frame.map_points[i] = point;
+      CreatePointFromDepth(frame, *kf, world_from_cam, i);
       frame.outlier[i] = false;
     }
     ++considered;

@@ -49,7 +49,7 @@ class Tracking {
   Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options);
 
   TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                       double timestamp, const std::vector<Detection>& detections);
+                       double timestamp);
 
   TrackingState State() const { return state_; }
   const std::vector<FrameRecord>& Records() const { return records_; }
@@ -63,7 +63,7 @@ class Tracking {
   bool Initialise(Frame& frame, const Rigid3d& cam_from_world);
   bool TrackWithMotionModel(Frame& frame);
   bool TrackReferenceKeyFrame(Frame& frame);
-  bool TrackLocalMap(Frame& frame, const std::vector<Detection>& detections, int* culled);
+  bool TrackLocalMap(Frame& frame);
   bool Relocalise(Frame& frame);
   bool NeedNewKeyFrame(const Frame& frame) const;
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame);
@@ -71,6 +71,9 @@ class Tracking {
   int DiscardOutliers(Frame& frame);
   void UpdateLocalMap(Frame& frame);
   int CountDepthPoints(const Frame& frame) const;
+  // A map point from keypoint i's depth, observed by `keyframe` (made from `frame`).
+  void CreatePointFromDepth(Frame& frame, KeyFrame& keyframe, const Rigid3d& world_from_cam,
+                            size_t i);
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
   void CorrectDepthScale(Frame& frame, bool inliers_only);
