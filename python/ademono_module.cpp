@@ -191,17 +191,6 @@ class PySequence {
 
 // ---- the SLAM system ----
 
-std::string StateName(TrackingState state) {
-  switch (state) {
-    case TrackingState::kNotInitialized:
-      return "not_initialized";
-    case TrackingState::kOk:
-      return "ok";
-    case TrackingState::kLost:
-      return "lost";
-  }
-  return "?";
-}
 
 struct PyTrackResult {
   size_t index = 0;
@@ -276,7 +265,7 @@ class PySystem {
     out.index = r.index;
     out.tracked = r.tracked;
     out.cam_from_world = PoseOrNone(r.cam_from_world);
-    out.state = StateName(r.state);
+    out.state = TrackingStateName(r.state);
     out.new_keyframe = r.new_keyframe;
     out.num_keypoints = r.num_keypoints;
     out.num_kept = r.num_kept;

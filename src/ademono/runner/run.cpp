@@ -58,18 +58,6 @@ nlohmann::json FilterStatsJson(const FilterStats& s) {
           {"kept", s.kept}};
 }
 
-const char* TrackingStateName(TrackingState state) {
-  switch (state) {
-    case TrackingState::kNotInitialized:
-      return "not_initialized";
-    case TrackingState::kOk:
-      return "ok";
-    case TrackingState::kLost:
-      return "lost";
-  }
-  throw std::logic_error("TrackingStateName: unknown state");
-}
-
 nlohmann::json RunAccuracy::ToJson() const {
   return {{"matched_poses", matched_poses},
           {"ate_se3_rmse_m", ate_se3_rmse_m},

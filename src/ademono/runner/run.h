@@ -56,7 +56,6 @@ struct FrameReport {
   FilterStats filter;
   FrameTiming ms;
 };
-const char* TrackingStateName(TrackingState state);  // "not_initialized" | "ok" | "lost"
 
 // ATE with se3 and sim3 alignment and RPE over 30 frames (se3), as `ademono eval` computes them.
 struct RunAccuracy {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <opencv2/calib3d.hpp>
 
 #include "ademono/core/cv_geometry.h"
@@ -13,6 +14,18 @@
 #include "ademono/slam/matcher.h"
 
 namespace ademono {
+
+const char* TrackingStateName(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized:
+      return "not_initialized";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kLost:
+      return "lost";
+  }
+  throw std::logic_error("TrackingStateName: unknown state");
+}
 
 Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
     : map_(map), local_mapping_(local_mapping), options_(options) {}

@@ -20,6 +20,8 @@
 namespace ademono {
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
+// "not_initialized" | "ok" | "lost" (summary.json, the Python API).
+const char* TrackingStateName(TrackingState state);
 
 // What the trajectory needs of each input frame: its pose relative to a keyframe, so that later
 // keyframe corrections (local BA, culling) move it along.
