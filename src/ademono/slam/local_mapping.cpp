@@ -15,21 +15,21 @@ namespace ademono {
 
 LocalMapping::LocalMapping(Map& map, const MappingOptions& options) : map_(map), options_(options) {
   options_.Check();
-  if (!options_.deterministic) worker_ = std::thread([this] { Run(); });
+  // One code path for both modes: keyframes always go through the queue to the mapping thread;
+  // deterministic mode only waits for each one to be mapped before tracking goes on.
+  worker_ = std::thread([this] { Run(); });
 }
 
 LocalMapping::~LocalMapping() { Shutdown(); }
 
 void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe) {
-  if (options_.deterministic) {
-    Process(keyframe);
-    return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    queue_.push_back(keyframe);
-  }
+  std::unique_lock<std::mutex> lock(queue_mutex_);
+  queue_.push_back(keyframe);
   queue_cv_.notify_one();
+  if (!options_.deterministic) return;
+  // Every keyframe decision then sees the same map, whatever the machine's load.
+  idle_cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || failure_; });
+  if (failure_) std::rethrow_exception(failure_);
 }
 
 bool LocalMapping::Idle() const {
@@ -69,9 +69,18 @@ void LocalMapping::Run() {
       queue_.pop_front();
       busy_ = true;
     }
-    Process(keyframe);
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    busy_ = false;
+    std::exception_ptr failure;
+    try {
+      Process(keyframe);
+    } catch (...) {
+      failure = std::current_exception();  // handed to the tracking thread, not std::terminate
+    }
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      busy_ = false;
+      if (failure && !failure_) failure_ = failure;
+    }
+    idle_cv_.notify_all();
   }
 }
 

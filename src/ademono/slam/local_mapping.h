@@ -3,12 +3,14 @@
 // points, culls recently created points that are rarely found, fuses duplicates with the
 // covisible keyframes, runs a local bundle adjustment and culls redundant keyframes.
 //
-// Two modes: deterministic (InsertKeyFrame processes the keyframe before returning; outputs are
-// identical run to run) and threaded (a worker thread processes a queue while tracking
-// continues; the local BA is solved outside the map lock).
+// One code path, two modes: keyframes always queue to the mapping thread, which processes them in
+// order (the local BA solved outside the map lock). Deterministic mode waits in InsertKeyFrame
+// until the keyframe is mapped (outputs identical run to run and under any load); threaded mode
+// returns at once and tracking continues concurrently.
 
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -54,6 +56,8 @@ class LocalMapping {
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
+  std::condition_variable idle_cv_;  // a keyframe finished (deterministic mode waits on it)
+  std::exception_ptr failure_;       // an exception of the mapping thread, rethrown to tracking
   std::deque<std::shared_ptr<KeyFrame>> queue_;
   bool busy_ = false;
   bool stop_ = false;
