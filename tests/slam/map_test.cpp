@@ -59,5 +59,32 @@ TEST(MapTest, ReplaceAndEraseKeepObservationsConsistent) {
   EXPECT_FALSE(kf0->bad);
 }
 
+TEST(MapTest, ACulledKeyFrameKeepsItsPoseLinkButNotItsKeypoints) {
+  // Memory grows with the map, not with the frames: culled keyframes drop their features, while
+  // frames that referenced them still resolve their poses through the spanning tree.
+  Map map;
+  const auto features = TestFeatures({{100, 100}, {200, 150}}, {1.5f, 2.0f}, 3);
+  Frame f0(0, 0, 0.0, features), f1(1, 1, 0.1, features);
+  f0.cam_from_world = Rigid3d::Identity();
+  f1.cam_from_world = Rigid3d::Identity();
+  f1.cam_from_world->translation() = Eigen::Vector3d(0.1, 0, 0);
+  auto kf0 = map.CreateKeyFrame(f0);
+  auto kf1 = map.CreateKeyFrame(f1);
+  kf1->parent = kf0.get();
+  kf0->children.insert(kf1.get());
+  ASSERT_EQ(kf1->F().Size(), 2u);
+  Rigid3d cam_from_kf1 = Rigid3d::Identity();
+  cam_from_kf1.translation() = Eigen::Vector3d(0, 0.2, 0);
+  const Rigid3d before = Map::ResolvePose(kf1.get(), cam_from_kf1);
+  map.EraseKeyFrame(kf1.get());
+  ASSERT_TRUE(kf1->bad);
+  EXPECT_EQ(kf1->F().Size(), 0u);
+  EXPECT_EQ(kf1->F().descriptors.rows, 0);
+  EXPECT_TRUE(kf1->F().FeaturesInArea(100, 100, 50).empty());
+  EXPECT_EQ(kf1->F().intrinsics.fx, features->intrinsics.fx);  // geometry kept
+  EXPECT_TRUE(Map::ResolvePose(kf1.get(), cam_from_kf1).isApprox(before, 1e-12));
+  EXPECT_EQ(features->Size(), 2u);  // the frame's own features are untouched
+}
+
 }  // namespace
 }  // namespace ademono

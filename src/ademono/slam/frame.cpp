@@ -95,6 +95,23 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
   return f;
 }
 
+std::shared_ptr<const FrameFeatures> WithoutKeypoints(const FrameFeatures& features) {
+  auto f = std::make_shared<FrameFeatures>();
+  f->camera = features.camera;
+  f->pyramid = features.pyramid;
+  f->intrinsics = features.intrinsics;
+  f->close_depth = features.close_depth;
+  f->min_x = features.min_x;
+  f->max_x = features.max_x;
+  f->min_y = features.min_y;
+  f->max_y = features.max_y;
+  f->descriptors = cv::Mat(0, features.descriptors.cols, features.descriptors.type());
+  f->depth_error = features.depth_error;
+  f->weight_by_error_model = features.weight_by_error_model;
+  f->depth_scale = features.depth_scale;
+  return f;  // no grid either: FeaturesInArea finds nothing
+}
+
 std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale) {
   auto f = std::make_shared<FrameFeatures>(features);
   f->depth_scale *= scale;
@@ -110,6 +127,7 @@ std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features,
 std::vector<size_t> FrameFeatures::FeaturesInArea(float u, float v, float r, int min_level,
                                                   int max_level) const {
   std::vector<size_t> result;
+  if (grid.empty()) return result;  // features without keypoints (a culled keyframe)
   const float cell_w = (max_x - min_x) / kGridCols;
   const float cell_h = (max_y - min_y) / kGridRows;
   const int x0 = std::max(0, static_cast<int>(std::floor((u - min_x - r) / cell_w)));

@@ -75,6 +75,10 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        const DepthErrorModel& depth_error = {},
                                                        bool weight_by_error_model = true);
 
+// The features without any keypoint (camera, pyramid, bounds and depth model kept): what a culled
+// keyframe needs, whose pose still resolves the frames that referenced it.
+std::shared_ptr<const FrameFeatures> WithoutKeypoints(const FrameFeatures& features);
+
 // The same features with every depth multiplied by `scale` (u_right recomputed, depth_scale
 // accumulated): the per-frame scale correction of network depth.
 std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale);

@@ -103,6 +103,10 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
   }
   keyframe->children.clear();
   keyframe->bad = true;
+  // Memory grows with the map, not with the frames: a culled keyframe keeps only its pose link
+  // (the frames that referenced it still resolve through it), not its keypoints or descriptors.
+  keyframe->features = WithoutKeypoints(keyframe->F());
+  keyframe->map_points.assign(keyframe->map_points.size(), nullptr);
   auto it = keyframes_.find(keyframe->id);
   if (it != keyframes_.end()) {
     graveyard_.push_back(it->second);
