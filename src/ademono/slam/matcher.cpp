@@ -294,15 +294,15 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
   const Eigen::Vector3d t = cam2_from_cam1.translation();
   Eigen::Matrix3d tx;
   tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
-  Eigen::Matrix3d K1inv = Eigen::Matrix3d::Identity(), K2inv = Eigen::Matrix3d::Identity();
-  K1inv(0, 0) = 1.0 / in1.fx;
-  K1inv(1, 1) = 1.0 / in1.fy;
-  K1inv(0, 2) = -in1.cx / in1.fx;
-  K1inv(1, 2) = -in1.cy / in1.fy;
-  K2inv(0, 0) = 1.0 / in2.fx;
-  K2inv(1, 1) = 1.0 / in2.fy;
-  K2inv(0, 2) = -in2.cx / in2.fx;
-  K2inv(1, 2) = -in2.cy / in2.fy;
+  auto inverse_k = [](const PinholeIntrinsics& in) {
+    Eigen::Matrix3d k_inv = Eigen::Matrix3d::Identity();
+    k_inv(0, 0) = 1.0 / in.fx;
+    k_inv(1, 1) = 1.0 / in.fy;
+    k_inv(0, 2) = -in.cx / in.fx;
+    k_inv(1, 2) = -in.cy / in.fy;
+    return k_inv;
+  };
+  const Eigen::Matrix3d K1inv = inverse_k(in1), K2inv = inverse_k(in2);
   // x2^T F21 x1 = 0 for pixels of the same point.
   const Eigen::Matrix3d F21 = K2inv.transpose() * tx * R * K1inv;
 

@@ -218,13 +218,10 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
 
   if (out.new_keyframe) {
     result.new_keyframe = true;
-    start = std::chrono::steady_clock::now();
     local_mapping_.InsertKeyFrame(out.new_keyframe);
-    result.mapping_ms = options_.mapping.deterministic ? MsSince(start) : 0.0;
   }
-  if (!options_.mapping.deterministic) {
-    result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
-  }
+  // Deterministic mode has waited for this keyframe; threaded mode reports what finished meanwhile.
+  result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
 
   // What the dynamic filter needs of this frame next time.
   // All keypoints, not only the kept ones: a point on a moving person removed in this frame must
