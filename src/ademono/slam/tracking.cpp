@@ -88,7 +88,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       lost_streak_ = 0;
       CorrectDepthScale(frame, true);
       if (NeedNewKeyFrame(frame)) {
-        out.map_rescale = AnchorScale(frame);
+        AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame);
       }
       // Outliers do not carry over to the next frame's motion-model search.
@@ -198,17 +198,15 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
   frame.features = RescaleDepth(f, static_cast<float>(estimate.scale));
 }
 
-double Tracking::AnchorScale(Frame& frame) {
+void Tracking::AnchorScale(Frame& frame) {
   if (!frame.F().DepthIsPrior() || !options_.depth.anchor_scale || log_scale_count_ == 0 ||
       !local_mapping_.Idle()) {
-    return 1.0;
+    return;
   }
   // This frame counts too (it is added to the sum after tracking).
   const double mean = (log_scale_sum_ + std::log(frame.F().depth_scale)) / (log_scale_count_ + 1);
-  if (std::abs(mean) <= options_.depth.anchor_tolerance) return 1.0;
-  const double factor = std::exp(-mean);
-  RescaleWorld(frame, factor);
-  return factor;
+  if (std::abs(mean) <= options_.depth.anchor_tolerance) return;
+  RescaleWorld(frame, std::exp(-mean));
 }
 
 void Tracking::RescaleWorld(Frame& frame, double factor) {

@@ -43,7 +43,6 @@ struct TrackingOutput {
   bool reinitialised = false;
   int dynamic_points_culled = 0;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
-  double map_rescale = 1.0;  // != 1 when the map was rescaled to the network's long-run scale
 };
 
 class Tracking {
@@ -79,8 +78,8 @@ class Tracking {
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
   void CorrectDepthScale(Frame& frame, bool inliers_only);
-  // Keeps the map at the network's long-run mean scale; returns the factor applied (1 if none).
-  double AnchorScale(Frame& frame);
+  // Keeps the map at the network's long-run mean scale (rescales the world when it drifted).
+  void AnchorScale(Frame& frame);
   // Multiplies every length of the map and of the tracker's state by `factor`.
   void RescaleWorld(Frame& frame, double factor);
 
