@@ -1,8 +1,8 @@
 #pragma once
-// The SLAM facade: one call per input frame. Extracts ORB features, reads each keypoint's depth
-// from the frame's metric depth map, applies the method's filters (enhancement, dynamic removal,
-// distant filter) and tracks the kept features; local mapping runs synchronously (deterministic)
-// or in its own thread.
+// The SLAM facade: one call per input frame. The front end (slam/front_end) extracts ORB
+// features, reads each keypoint's depth from the frame's metric depth map and applies the
+// method's filters (enhancement, dynamic removal, distant filter); the back end (slam/back_end)
+// tracks the kept features against the map, culls points on moving objects and maps.
 
 #include <filesystem>
 #include <memory>
@@ -10,13 +10,12 @@
 #include <vector>
 
 #include "ademono/core/camera.h"
-#include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
 #include "ademono/perception/detection.h"
-#include "ademono/slam/local_mapping.h"
-#include "ademono/slam/map.h"
+#include "ademono/slam/back_end.h"
+#include "ademono/slam/front_end.h"
 #include "ademono/slam/options.h"
 #include "ademono/slam/tracking.h"
 
@@ -62,10 +61,7 @@ class System {
   // Network depth: the scale correction of every tracked frame (input index, factor), against
   // the final map (anchoring rescales update it); 1 for sensor depth.
   std::vector<std::pair<size_t, double>> DepthScales() const;
-  struct ColoredPoint {
-    Eigen::Vector3d position;
-    cv::Vec3b bgr;
-  };
+  using ColoredPoint = ademono::ColoredPoint;
   std::vector<ColoredPoint> MapPointCloud() const;
   size_t NumKeyFrames() const;
   size_t NumMapPoints() const;
@@ -76,26 +72,15 @@ class System {
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
-                                           const cv::Mat& depth, const FrameDepthOptions& options);
+                                           const cv::Mat& depth, const FrameDepthOptions& options) {
+    return FrontEnd::KeypointDepths(keypoints, depth, options);
+  }
 
  private:
-  // Counts hits of map points landing on moving objects (map_.mutex held) and erases those with
-  // tracking.dynamic_cull_hits of them; returns how many were erased.
-  int CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::Mat& depth,
-                                 const std::vector<Detection>& moving_boxes);
-
   Camera camera_;
   SystemOptions options_;
-  OrbExtractor extractor_;
-  std::shared_ptr<const ScalePyramid> pyramid_;
-  FeatureFilter filter_;
-  mutable Map map_;  // mutable: const accessors lock its mutex
-  LocalMapping local_mapping_;
-  Tracking tracking_;
-  std::optional<PreviousFrameFeatures> previous_;
-  // Colour of each map point's first observation (for map.ply), keyed by point id.
-  std::map<uint64_t, cv::Vec3b> point_colors_;
-  bool shut_down_ = false;
+  FrontEnd front_end_;
+  BackEnd back_end_;
 };
 
 }  // namespace ademono

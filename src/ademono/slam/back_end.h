@@ -1,0 +1,76 @@
+#pragma once
+// The back end of the SLAM system: a front end's filtered frame meets the map. Tracking (pose,
+// keyframe decision), culling of map points on moving objects, and local mapping; it owns the
+// map and answers every question about it (trajectories, point cloud, counts).
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "ademono/core/camera.h"
+#include "ademono/io/sequence.h"
+#include "ademono/io/trajectory.h"
+#include "ademono/perception/detection.h"
+#include "ademono/slam/front_end.h"
+#include "ademono/slam/local_mapping.h"
+#include "ademono/slam/map.h"
+#include "ademono/slam/options.h"
+#include "ademono/slam/tracking.h"
+
+namespace ademono {
+
+struct ColoredPoint {
+  Eigen::Vector3d position;
+  cv::Vec3b bgr;
+};
+
+// The back end's part of one frame's result.
+struct BackEndResult {
+  TrackingOutput tracking;
+  TrackingState state = TrackingState::kNotInitialized;
+  bool new_keyframe = false;
+  double tracking_ms = 0;  // tracking and culling, map lock held
+  double mapping_ms = 0;   // local mapping of the keyframes finished by this frame
+};
+
+class BackEnd {
+ public:
+  BackEnd(const Camera& camera, const SystemOptions& options);
+  ~BackEnd();
+  BackEnd(const BackEnd&) = delete;
+  BackEnd& operator=(const BackEnd&) = delete;
+
+  // Constant-velocity prediction of the next frame's pose (the dynamic filter's stage 2).
+  std::optional<Rigid3d> PredictNext() const;
+  // `frame`: its index, timestamp and image (map point colours); `depth` as System::TrackFrame.
+  BackEndResult Track(const FrameData& frame, const cv::Mat& depth, const FilteredFrame& filtered);
+  // Finishes local mapping. Idempotent.
+  void Shutdown();
+
+  Trajectory FrameTrajectory() const;
+  Trajectory KeyFrameTrajectory() const;
+  std::vector<std::pair<size_t, double>> DepthScales() const;
+  std::vector<ColoredPoint> MapPointCloud() const;
+  size_t NumKeyFrames() const;
+  size_t NumMapPoints() const;
+  int NumLost() const;
+  int NumTracked() const;
+
+ private:
+  // Counts hits of map points landing on moving objects (map_.mutex held) and erases those with
+  // tracking.dynamic_cull_hits of them; returns how many were erased.
+  int CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::Mat& depth,
+                                 const std::vector<Detection>& moving_boxes);
+
+  Camera camera_;
+  SystemOptions options_;
+  mutable Map map_;  // mutable: const accessors lock its mutex
+  LocalMapping local_mapping_;
+  Tracking tracking_;
+  // Colour of each map point's first observation (for map.ply), keyed by point id.
+  std::map<uint64_t, cv::Vec3b> point_colors_;
+  bool shut_down_ = false;
+};
+
+}  // namespace ademono
