@@ -37,7 +37,6 @@ struct RunArgs : SequenceRunArgs {
   bool no_enhancement = false;
   bool no_dynamic_removal = false;
   bool no_distant_filter = false;
-  bool threaded = false;
 };
 
 // The filter's view of the frame (boxes as the filter grew them, keypoints by label, legend).
@@ -65,7 +64,6 @@ int Run(const RunArgs& args) {
   if (args.no_enhancement) options.filter.enable_enhancement = false;
   if (args.no_dynamic_removal) options.filter.enable_dynamic_removal = false;
   if (args.no_distant_filter) options.filter.enable_distant_filter = false;
-  if (args.threaded) options.mapping.deterministic = false;
 
   RunOptions run;
   run.system = options;
@@ -144,9 +142,6 @@ const bool kRegistered = RegisterCommand(
                    "disable dynamic interference removal");
       app.add_flag("--no-distant-filter", args->no_distant_filter,
                    "disable distant-point filtering");
-      app.add_flag(
-          "--threaded", args->threaded,
-          "local mapping in its own thread (faster wall time, not reproducible run to run)");
       return [args] { return Run(*args); };
     });
 

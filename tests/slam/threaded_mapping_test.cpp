@@ -1,12 +1,16 @@
-// The threaded mapping path (`mapping.deterministic: false`, `ademono run --threaded`): local
-// mapping on its own thread while tracking goes on. Outputs are not bit-reproducible there, so
-// the tests bound accuracy and count tracked frames instead. Also built with -fsanitize=thread
-// (scripts/setup.sh --tsan) to check the map's locking.
+// The threaded mapping path (`mapping.threaded: true`, the default): each keyframe's local BA is
+// solved on the mapping thread while tracking goes on, and merged at a fixed hand-off frame
+// (`mapping.handoff_frames`). The tests bound accuracy, count tracked frames, and check that the
+// schedule is deterministic: the same trajectory with the solve on the tracking thread, and with
+// a busy thread competing for the cores. Also built with -fsanitize=thread (scripts/setup.sh
+// --tsan) to check the map's locking.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
+#include <thread>
 #include <opencv2/core/utility.hpp>
 
 #include "ademono/depth/depth_factory.h"
@@ -59,14 +63,15 @@ class ThreadedMappingTest : public ::testing::Test {
   };
 
   // Runs the sequence's first `frames` frames with exact depth and the ground-truth boxes.
-  static Run RunThreaded(size_t frames) {
+  static Run RunThreaded(size_t frames, bool threaded = true, int handoff_frames = 4) {
     const auto sequence = OpenSequence("tum:" + dir_.string());
     DepthFactoryContext context;
     context.sequence = sequence.get();
     const auto depth = MakeDepthProvider("sensor", context);
     const auto detector = MakeDetector("cache:" + (dir_ / "detections.jsonl").string(), {});
     SystemOptions options;
-    options.mapping.deterministic = false;
+    options.mapping.threaded = threaded;
+    options.mapping.handoff_frames = handoff_frames;
     System system(sequence->GetCamera(), options);
     PipelineOptions pipeline;
     pipeline.end = frames;
@@ -108,6 +113,39 @@ TEST_F(ThreadedMappingTest, TracksTheOfficeAccurately) {
   // used to repeat the last keyframe's time on every frame).
   EXPECT_LE(run.frames_with_mapping, run.keyframes_inserted);
   EXPECT_LE(run.mapping_ms, 1000.0 * run.wall_seconds);
+}
+
+// Poses as exact bytes: a deterministic schedule gives the same doubles, not merely close ones.
+std::vector<double> PoseValues(const Trajectory& trajectory) {
+  std::vector<double> values;
+  for (const auto& pose : trajectory) {
+    values.push_back(pose.timestamp);
+    const Eigen::Matrix4d m = pose.world_from_cam.matrix();
+    values.insert(values.end(), m.data(), m.data() + 16);
+  }
+  return values;
+}
+
+TEST_F(ThreadedMappingTest, HandOffScheduleIsDeterministicUnderLoad) {
+  const Run inline_solve = RunThreaded(60, /*threaded=*/false);
+  // A busy loop on another thread: the mapping thread now finishes at other times, which must
+  // not change a single bit of the result.
+  std::atomic<bool> stop{false};
+  std::thread busy([&] {
+    volatile double x = 1;
+    while (!stop.load(std::memory_order_relaxed)) x = x * 1.0000001 + 1e-9;
+  });
+  const Run threaded = RunThreaded(60, /*threaded=*/true);
+  stop = true;
+  busy.join();
+  EXPECT_EQ(inline_solve.tracked, 60);
+  EXPECT_EQ(threaded.keyframes, inline_solve.keyframes);
+  EXPECT_EQ(threaded.map_points, inline_solve.map_points);
+  EXPECT_EQ(PoseValues(threaded.trajectory), PoseValues(inline_solve.trajectory));
+  // A different schedule is a different (still accurate) result.
+  const Run synchronous = RunThreaded(60, /*threaded=*/true, /*handoff_frames=*/0);
+  EXPECT_EQ(synchronous.tracked, 60);
+  EXPECT_LT(AteSe3(synchronous.trajectory), 0.03);
 }
 
 TEST_F(ThreadedMappingTest, StopsCleanlyMidSequence) {

@@ -207,7 +207,8 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
   j["depth"] = report.depth;
   j["detector"] = report.detector;
   j["seed"] = o.filter.seed;
-  j["deterministic"] = o.mapping.deterministic;
+  // Every mapping schedule is deterministic (slam/local_mapping.h); the key stays for the schema.
+  j["deterministic"] = true;
   j["filters"] = {{"enhancement", o.filter.enable_enhancement},
                   {"dynamic_removal", o.filter.enable_dynamic_removal},
                   {"distant", o.filter.enable_distant_filter}};

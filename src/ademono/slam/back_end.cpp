@@ -21,6 +21,8 @@ void BackEnd::Shutdown() {
   local_mapping_.Shutdown();
 }
 
+void BackEnd::HandOff(size_t frame_index) { local_mapping_.HandOff(frame_index); }
+
 std::optional<Rigid3d> BackEnd::PredictNext() const {
   std::lock_guard<std::mutex> lock(map_.mutex);
   return tracking_.PredictNext();
@@ -87,9 +89,9 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   if (out.new_keyframe) {
     result.new_keyframe = true;
-    local_mapping_.InsertKeyFrame(out.new_keyframe);
+    local_mapping_.InsertKeyFrame(out.new_keyframe, frame.index);
   }
-  // Deterministic mode has waited for this keyframe; threaded mode reports what finished meanwhile.
+  // The keyframes merged by this frame (at their hand-off), each once.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
   return result;
 }

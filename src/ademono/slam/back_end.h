@@ -41,6 +41,9 @@ class BackEnd {
   BackEnd(const BackEnd&) = delete;
   BackEnd& operator=(const BackEnd&) = delete;
 
+  // Start of a frame's back end, before PredictNext and Track: merges local mapping's pending
+  // keyframe when this frame is its hand-off frame (the fixed schedule, slam/local_mapping.h).
+  void HandOff(size_t frame_index);
   // Constant-velocity prediction of the next frame's pose (the dynamic filter's stage 2).
   std::optional<Rigid3d> PredictNext() const;
   // `frame`: its index, timestamp and image (map point colours); `depth` as System::TrackFrame.

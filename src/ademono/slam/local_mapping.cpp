@@ -15,77 +15,42 @@ namespace ademono {
 
 LocalMapping::LocalMapping(Map& map, const MappingOptions& options) : map_(map), options_(options) {
   options_.Check();
-  // One code path for both modes: keyframes always go through the queue to the mapping thread;
-  // deterministic mode only waits for each one to be mapped before tracking goes on.
-  worker_ = std::thread([this] { Run(); });
+  if (options_.threaded) worker_ = std::thread([this] { Run(); });
 }
 
-LocalMapping::~LocalMapping() { Shutdown(); }
-
-void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe) {
-  std::unique_lock<std::mutex> lock(queue_mutex_);
-  queue_.push_back(keyframe);
-  queue_cv_.notify_one();
-  if (!options_.deterministic) return;
-  // Every keyframe decision then sees the same map, whatever the machine's load.
-  idle_cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || failure_; });
-  if (failure_) std::rethrow_exception(failure_);
+LocalMapping::~LocalMapping() {
+  try {
+    Shutdown();
+  } catch (const std::exception& e) {
+    spdlog::error("local mapping: {}", e.what());  // a destructor must not throw
+  }
 }
 
-bool LocalMapping::Idle() const {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
-  return queue_.empty() && !busy_;
+namespace {
+double MsSinceStart(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
+}  // namespace
 
-size_t LocalMapping::QueueSize() const {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
-  return queue_.size();
-}
+bool LocalMapping::Idle() const { return pending_ == nullptr; }
 
 double LocalMapping::TakeFinishedMilliseconds() {
-  std::lock_guard<std::mutex> lock(queue_mutex_);
   const double ms = finished_ms_;
   finished_ms_ = 0;
   return ms;
 }
 
-void LocalMapping::Shutdown() {
-  {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    stop_ = true;
-  }
-  queue_cv_.notify_all();
-  if (worker_.joinable()) worker_.join();
+void LocalMapping::HandOff(size_t frame_index) {
+  if (pending_ && frame_index >= pending_->handoff_frame) Merge();
 }
 
-void LocalMapping::Run() {
-  while (true) {
-    std::shared_ptr<KeyFrame> keyframe;
-    {
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait(lock, [this] { return stop_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping and drained
-      keyframe = queue_.front();
-      queue_.pop_front();
-      busy_ = true;
-    }
-    std::exception_ptr failure;
-    try {
-      Process(keyframe);
-    } catch (...) {
-      failure = std::current_exception();  // handed to the tracking thread, not std::terminate
-    }
-    {
-      std::lock_guard<std::mutex> lock(queue_mutex_);
-      busy_ = false;
-      if (failure && !failure_) failure_ = failure;
-    }
-    idle_cv_.notify_all();
-  }
-}
-
-void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
+void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, size_t frame_index) {
+  if (pending_) Merge();  // one keyframe in flight: the next one maps on the merged map
   const auto start = std::chrono::steady_clock::now();
+  auto pending = std::make_unique<Pending>();
+  pending->keyframe = keyframe;
+  pending->handoff_frame = frame_index + static_cast<size_t>(options_.handoff_frames);
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
     ProcessNewKeyFrame(*keyframe);
@@ -95,18 +60,79 @@ void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
       spdlog::debug("keyframe {}: {} map points triangulated", keyframe->id, created);
     }
     FuseNeighbours(*keyframe);
+    pending->has_ba = options_.local_ba && GatherBundleAdjustment(*keyframe, *pending);
   }
-  // In threaded mode a waiting keyframe is more urgent than refining this one (as ORB-SLAM).
-  const bool more_waiting = !options_.deterministic && QueueSize() > 0;
-  if (options_.local_ba && !more_waiting) LocalBundleAdjustment(*keyframe);
+  pending->ms = MsSinceStart(start);
+  pending_ = std::move(pending);
+  if (pending_->has_ba && options_.threaded) {
+    std::lock_guard<std::mutex> lock(job_mutex_);
+    job_ = pending_.get();
+    job_done_ = false;
+    job_cv_.notify_all();
+  } else if (pending_->has_ba) {
+    Solve(*pending_);  // same result as the thread's, on this thread
+  }
+  if (options_.handoff_frames == 0) Merge();
+}
+
+void LocalMapping::Solve(Pending& pending) const {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    pending.result = SolveBundleAdjustment(pending.problem, options_.ba);
+  } catch (...) {
+    pending.failure = std::current_exception();  // rethrown to tracking at the hand-off
+  }
+  pending.ms += MsSinceStart(start);
+}
+
+void LocalMapping::Merge() {
+  if (!pending_) return;
+  if (pending_->has_ba && options_.threaded) {
+    std::unique_lock<std::mutex> lock(job_mutex_);
+    job_cv_.wait(lock, [this] { return job_done_; });
+    job_ = nullptr;
+  }
+  std::unique_ptr<Pending> pending = std::move(pending_);
+  if (pending->failure) std::rethrow_exception(pending->failure);
+  const auto start = std::chrono::steady_clock::now();
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
-    CullKeyFrames(*keyframe);
+    if (pending->has_ba) ApplyBundleAdjustment(*pending);
+    CullKeyFrames(*pending->keyframe);
   }
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::lock_guard<std::mutex> lock(queue_mutex_);
-  finished_ms_ += ms;
+  finished_ms_ += pending->ms + MsSinceStart(start);
+}
+
+void LocalMapping::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  std::exception_ptr failure;
+  try {
+    Merge();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  {
+    std::lock_guard<std::mutex> lock(job_mutex_);
+    stop_ = true;
+  }
+  job_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+void LocalMapping::Run() {
+  std::unique_lock<std::mutex> lock(job_mutex_);
+  while (true) {
+    job_cv_.wait(lock, [this] { return stop_ || (job_ != nullptr && !job_done_); });
+    if (stop_) return;
+    Pending* job = job_;
+    lock.unlock();
+    Solve(*job);  // touches only the snapshot in *job, never the map
+    lock.lock();
+    job_done_ = true;
+    job_cv_.notify_all();
+  }
 }
 
 void LocalMapping::ProcessNewKeyFrame(KeyFrame& keyframe) {
@@ -268,16 +294,15 @@ void LocalMapping::FuseNeighbours(KeyFrame& keyframe) {
   keyframe.UpdateConnections();
 }
 
-void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
-  // Gather the problem under the lock: keyframe + covisibles are free, keyframes that see the
-  // local points but are not local are fixed (the first keyframe is always fixed).
-  BundleAdjustmentProblem problem;
-  std::vector<std::shared_ptr<KeyFrame>> cameras;
-  std::vector<std::shared_ptr<MapPoint>> points;
-  std::vector<std::pair<KeyFrame*, size_t>> observation_refs;  // (keyframe, keypoint index)
+bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) {
+  // Keyframe + covisibles are free, keyframes that see the local points but are not local are
+  // fixed (the first keyframe is always fixed).
+  BundleAdjustmentProblem& problem = pending.problem;
+  std::vector<std::shared_ptr<KeyFrame>>& cameras = pending.cameras;
+  std::vector<std::shared_ptr<MapPoint>>& points = pending.points;
+  std::vector<std::pair<KeyFrame*, size_t>>& observation_refs = pending.observation_refs;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex);
-    if (keyframe.bad) return;
+    if (keyframe.bad) return false;
     std::vector<KeyFrame*> local{&keyframe};
     keyframe.ba_local_for = keyframe.id;
     for (KeyFrame* kf : keyframe.ordered_connections) {
@@ -319,7 +344,7 @@ void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
     for (KeyFrame* kf : fixed) add_camera(kf, true);
     bool any_free = false;
     for (const BaCamera& c : problem.cameras) any_free = any_free || !c.fixed;
-    if (!any_free || local_points.empty()) return;
+    if (!any_free || local_points.empty()) return false;
     // The first keyframe alone fixed leaves the gauge free when nothing else is fixed; ORB-SLAM
     // accepts that, but a fixed frame keeps repeated runs anchored.
     problem.intrinsics = keyframe.F().intrinsics;
@@ -336,12 +361,18 @@ void LocalMapping::LocalBundleAdjustment(KeyFrame& keyframe) {
     }
   }
   for (const auto& c : cameras) {
-    if (!c) return;  // a keyframe was culled meanwhile (cannot happen in this thread)
+    if (!c) return false;  // not in the map (cannot happen: gathered under the lock)
   }
+  return true;
+}
 
-  const BundleAdjustmentResult result = SolveBundleAdjustment(problem, options_.ba);
-
-  std::lock_guard<std::mutex> lock(map_.mutex);
+void LocalMapping::ApplyBundleAdjustment(const Pending& pending) {
+  // Points culled or fused since the gather are bad and skipped; keyframes are only culled here.
+  const BundleAdjustmentProblem& problem = pending.problem;
+  const BundleAdjustmentResult& result = *pending.result;
+  const auto& cameras = pending.cameras;
+  const auto& points = pending.points;
+  const auto& observation_refs = pending.observation_refs;
   for (size_t i = 0; i < problem.observations.size(); ++i) {
     if (!result.outlier[i]) continue;
     auto [kf, idx] = observation_refs[i];

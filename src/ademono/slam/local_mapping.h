@@ -3,19 +3,27 @@
 // points, culls recently created points that are rarely found, fuses duplicates with the
 // covisible keyframes, runs a local bundle adjustment and culls redundant keyframes.
 //
-// One code path, two modes: keyframes always queue to the mapping thread, which processes them in
-// order (the local BA solved outside the map lock). Deterministic mode waits in InsertKeyFrame
-// until the keyframe is mapped (outputs identical run to run and under any load); threaded mode
-// returns at once and tracking continues concurrently.
+// Deterministic and concurrent: a fixed hand-off schedule. When tracking makes keyframe k at
+// frame f, the map-editing steps (point registration, culling, triangulation, fusion) run at once
+// on the tracking thread and the local BA problem is gathered there; the BA is then solved on the
+// mapping thread from that snapshot, while tracking goes on against the unchanged map, and its
+// result is merged (poses, points, outliers, then keyframe culling) under the map lock exactly
+// when frame f + mapping.handoff_frames starts, or earlier when the next keyframe comes. Tracking
+// never sees a half-applied BA and every decision depends only on the data, never on whether the
+// mapper happens to be idle: outputs are identical run to run, under any load, and with
+// mapping.threaded false (the solve runs on the tracking thread instead). handoff_frames 0 is the
+// synchronous schedule (BA merged before the next frame).
 
+#include <chrono>
 #include <condition_variable>
-#include <deque>
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
+#include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
 
@@ -28,40 +36,63 @@ class LocalMapping {
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
 
-  // The caller must not hold map.mutex.
-  void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe);
-  // True when no keyframe is queued or being processed (always true in deterministic mode).
+  // Tracking thread, map.mutex not held. Merges the pending keyframe's BA when `frame_index` has
+  // reached its hand-off frame (waits for the mapping thread if it is not done).
+  void HandOff(size_t frame_index);
+  // Tracking thread, map.mutex not held: keyframe made at `frame_index`. Merges a pending
+  // keyframe first, maps this one's structure and starts its BA.
+  void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, size_t frame_index);
+  // True when no keyframe waits for its hand-off. A function of the frame indices alone (never
+  // of the mapping thread's progress), so tracking may decide on it deterministically.
   bool Idle() const;
-  size_t QueueSize() const;
-  // Blocks until the queue is empty (threaded mode), then stops the worker.
+  size_t QueueSize() const { return Idle() ? 0 : 1; }
+  // Merges the pending keyframe and stops the worker. Idempotent.
   void Shutdown();
-  // Wall time (ms) of the keyframes whose processing finished since the last call, each counted
-  // once: in threaded mode a frame reports the mapping work that completed while it was tracked.
+  // Milliseconds of mapping work (structure, BA solve, merge) of the keyframes merged since the
+  // last call, each counted once, at its hand-off frame.
   double TakeFinishedMilliseconds();
 
  private:
+  // A keyframe between its insertion and its hand-off.
+  struct Pending {
+    std::shared_ptr<KeyFrame> keyframe;
+    size_t handoff_frame = 0;
+    bool has_ba = false;
+    BundleAdjustmentProblem problem;
+    std::vector<std::shared_ptr<KeyFrame>> cameras;
+    std::vector<std::shared_ptr<MapPoint>> points;
+    std::vector<std::pair<KeyFrame*, size_t>> observation_refs;  // (keyframe, keypoint index)
+    std::optional<BundleAdjustmentResult> result;
+    std::exception_ptr failure;
+    double ms = 0;  // structure + gather (tracking thread) + solve
+  };
+
   void Run();
-  void Process(const std::shared_ptr<KeyFrame>& keyframe);
+  void Solve(Pending& pending) const;
+  // Waits for the pending BA, applies it and culls keyframes (map lock taken here).
+  void Merge();
   void ProcessNewKeyFrame(KeyFrame& keyframe);
   void CullMapPoints(const KeyFrame& keyframe);
   // Triangulates new map points with the best covisible keyframes; returns how many.
   int CreateNewMapPoints(KeyFrame& keyframe);
   void FuseNeighbours(KeyFrame& keyframe);
-  void LocalBundleAdjustment(KeyFrame& keyframe);
+  // Gathers the local BA around the keyframe (map.mutex held); false: nothing to optimise.
+  bool GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending);
+  void ApplyBundleAdjustment(const Pending& pending);
   void CullKeyFrames(KeyFrame& keyframe);
 
   Map& map_;
   MappingOptions options_;
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
+  std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below
 
-  mutable std::mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::condition_variable idle_cv_;  // a keyframe finished (deterministic mode waits on it)
-  std::exception_ptr failure_;       // an exception of the mapping thread, rethrown to tracking
-  std::deque<std::shared_ptr<KeyFrame>> queue_;
-  bool busy_ = false;
-  bool stop_ = false;
-  double finished_ms_ = 0;  // guarded by queue_mutex_
+  std::mutex job_mutex_;
+  std::condition_variable job_cv_;
+  Pending* job_ = nullptr;  // handed to the mapping thread; guarded by job_mutex_
+  bool job_done_ = false;   // guarded by job_mutex_
+  bool stop_ = false;       // guarded by job_mutex_
+  double finished_ms_ = 0;  // tracking thread only
+  bool shut_down_ = false;
   std::thread worker_;
 };
 

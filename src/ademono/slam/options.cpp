@@ -89,7 +89,8 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
   using M = MappingOptions;
   static const auto table =
       OptionsTable<M>("mapping")
-          .Add("deterministic", &M::deterministic)
+          .Add("threaded", &M::threaded)
+          .Add("handoff_frames", &M::handoff_frames, Range::AtLeast(0))
           .Add("local_ba", &M::local_ba)
           .Add("cull_found_ratio", &M::cull_found_ratio, Range::ClosedOpen(0, 1))
           .Add("cull_min_observations", &M::cull_min_observations, Range::AtLeast(1))

@@ -96,9 +96,13 @@ struct TrackingOptions {
 };
 
 struct MappingOptions {
-  // true: local mapping runs synchronously after each keyframe (identical output run to run);
-  // false: in its own thread, concurrent with tracking (faster wall time, not reproducible).
-  bool deterministic = true;
+  // Local mapping's schedule (slam/local_mapping.h). Every setting is deterministic: outputs are
+  // identical run to run and under any load. threaded: the local BA is solved on the mapping
+  // thread (false: on the tracking thread, same result). handoff_frames: the BA of a keyframe
+  // made at frame f is merged when frame f + handoff_frames starts (or the next keyframe comes);
+  // 0 merges it before the next frame (the synchronous schedule).
+  bool threaded = true;
+  int handoff_frames = 0;
   bool local_ba = true;
   int ba_max_keyframes = 0;        // free keyframes in the local BA (best covisibles); 0 = all
   double cull_found_ratio = 0.25;  // found / visible below this: point culled
