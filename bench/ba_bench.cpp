@@ -8,12 +8,12 @@
 // Re-record the problem (the local BA of the last keyframe after --frames frames):
 //   build/release/bench_ba --record=tests/data/ba/seq_a_local_ba.bin --frames=120
 #include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstring>
 #include <iostream>
 #include <memory>
 #include <string>
-#include <yaml-cpp/yaml.h>
 
 #include "ademono/depth/depth_factory.h"
 #include "ademono/io/sequence.h"

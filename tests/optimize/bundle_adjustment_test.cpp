@@ -1,12 +1,12 @@
 #include "ademono/optimize/bundle_adjustment.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <unistd.h>
 
 #include "ademono/core/options_table.h"
 
@@ -124,8 +124,8 @@ TEST(BundleAdjustmentTest, AnalyticJacobiansSolveLikeAutoDiffWithEverySolver) {
 }
 
 TEST(BundleAdjustmentTest, OptionsReadAndRejectUnknownChoices) {
-  const auto options = ReadOptions<BundleAdjustmentOptions>(YAML::Load(
-      "{ba_jacobians: autodiff, ba_linear_solver: dense_schur}"));
+  const auto options = ReadOptions<BundleAdjustmentOptions>(
+      YAML::Load("{ba_jacobians: autodiff, ba_linear_solver: dense_schur}"));
   EXPECT_FALSE(options.analytic_jacobians);
   EXPECT_EQ(options.linear_solver, BaLinearSolver::kDenseSchur);
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_linear_solver: qr}")));
@@ -137,9 +137,9 @@ TEST(BundleAdjustmentTest, ProblemFileRoundTripsAndRejectsBadFiles) {
   std::vector<Rigid3d> poses;
   std::vector<Eigen::Vector3d> points;
   const BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("ba_problem_" + std::to_string(::getpid()) + ".bin"))
-          .string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("ba_problem_" + std::to_string(::getpid()) + ".bin"))
+                               .string();
   WriteBundleAdjustmentProblem(problem, path);
   const BundleAdjustmentProblem read = ReadBundleAdjustmentProblem(path);
   ASSERT_EQ(read.cameras.size(), problem.cameras.size());

@@ -21,7 +21,8 @@ const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
           .AddChoice<BaLinearSolver>("ba_linear_solver", &B::linear_solver,
                                      {{"sparse_schur", BaLinearSolver::kSparseSchur},
                                       {"dense_schur", BaLinearSolver::kDenseSchur},
-                                      {"iterative_schur", BaLinearSolver::kIterativeSchur}});;
+                                      {"iterative_schur", BaLinearSolver::kIterativeSchur}});
+  ;
   return table;
 }
 
@@ -139,10 +140,12 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
 
   BundleAdjustmentResult result;
   result.outlier.assign(problem.observations.size(), false);
-  result.converged = Solve(problem, options, result.outlier, options.first_iterations, cameras, points);
+  result.converged =
+      Solve(problem, options, result.outlier, options.first_iterations, cameras, points);
   ClassifyOutliers(problem, cameras, points, result.outlier);
   if (options.second_iterations > 0) {
-    result.converged = Solve(problem, options, result.outlier, options.second_iterations, cameras, points);
+    result.converged =
+        Solve(problem, options, result.outlier, options.second_iterations, cameras, points);
     ClassifyOutliers(problem, cameras, points, result.outlier);
   }
 
@@ -241,8 +244,8 @@ BundleAdjustmentProblem ReadBundleAdjustmentProblem(const std::string& path) {
     o.point = Get<uint32_t>(in, path);
     if (o.camera >= num_cameras || o.point >= num_points)
       throw std::runtime_error(path + ": observation index out of range");
-    for (double* v : {&o.image.pixel.x(), &o.image.pixel.y(), &o.image.u_right,
-                      &o.image.inv_sigma2, &o.image.depth_inv_sigma})
+    for (double* v : {&o.image.pixel.x(), &o.image.pixel.y(), &o.image.u_right, &o.image.inv_sigma2,
+                      &o.image.depth_inv_sigma})
       *v = Get<double>(in, path);
   }
   if (in.peek() != std::char_traits<char>::eof())
