@@ -1,8 +1,14 @@
 #include "ademono/optimize/bundle_adjustment.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <random>
+
+#include "ademono/core/options_table.h"
 
 namespace ademono {
 namespace {
@@ -89,6 +95,85 @@ TEST(BundleAdjustmentTest, DeterministicAndValidatesIndices) {
   }
   problem.observations[0].point = 100000;
   EXPECT_THROW(SolveBundleAdjustment(problem), std::invalid_argument);
+}
+
+TEST(BundleAdjustmentTest, AnalyticJacobiansSolveLikeAutoDiffWithEverySolver) {
+  std::mt19937 rng(10);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  const BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  BundleAdjustmentOptions reference_options;
+  reference_options.analytic_jacobians = false;
+  const auto reference = SolveBundleAdjustment(problem, reference_options);
+  for (BaLinearSolver solver : {BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur,
+                                BaLinearSolver::kIterativeSchur}) {
+    BundleAdjustmentOptions options;
+    options.linear_solver = solver;
+    const auto result = SolveBundleAdjustment(problem, options);
+    // The iterative solver stops at its own tolerance: close, not as close.
+    const double tolerance = solver == BaLinearSolver::kIterativeSchur ? 1e-4 : 1e-7;
+    for (size_t c = 0; c < poses.size(); ++c) {
+      EXPECT_LT((result.cam_from_world[c].matrix() - reference.cam_from_world[c].matrix())
+                    .cwiseAbs()
+                    .maxCoeff(),
+                tolerance)
+          << static_cast<int>(solver) << " camera " << c;
+    }
+    EXPECT_EQ(result.outlier, reference.outlier);
+  }
+}
+
+TEST(BundleAdjustmentTest, OptionsReadAndRejectUnknownChoices) {
+  const auto options = ReadOptions<BundleAdjustmentOptions>(
+      YAML::Load("{ba_jacobians: autodiff, ba_linear_solver: dense_schur}"));
+  EXPECT_FALSE(options.analytic_jacobians);
+  EXPECT_EQ(options.linear_solver, BaLinearSolver::kDenseSchur);
+  EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_linear_solver: qr}")));
+  EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_jacobians: numeric}")));
+}
+
+TEST(BundleAdjustmentTest, ProblemFileRoundTripsAndRejectsBadFiles) {
+  std::mt19937 rng(12);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  const BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("ba_problem_" + std::to_string(::getpid()) + ".bin"))
+                               .string();
+  WriteBundleAdjustmentProblem(problem, path);
+  const BundleAdjustmentProblem read = ReadBundleAdjustmentProblem(path);
+  ASSERT_EQ(read.cameras.size(), problem.cameras.size());
+  ASSERT_EQ(read.observations.size(), problem.observations.size());
+  for (size_t c = 0; c < problem.cameras.size(); ++c) {
+    EXPECT_EQ(read.cameras[c].fixed, problem.cameras[c].fixed);
+    EXPECT_TRUE(read.cameras[c].cam_from_world.matrix() ==
+                problem.cameras[c].cam_from_world.matrix());
+  }
+  for (size_t i = 0; i < problem.observations.size(); ++i) {
+    EXPECT_EQ(read.observations[i].point, problem.observations[i].point);
+    EXPECT_EQ(read.observations[i].image.pixel, problem.observations[i].image.pixel);
+    EXPECT_EQ(read.observations[i].image.u_right, problem.observations[i].image.u_right);
+  }
+  // Same problem, same solution.
+  const auto a = SolveBundleAdjustment(problem), b = SolveBundleAdjustment(read);
+  for (size_t c = 0; c < poses.size(); ++c)
+    EXPECT_TRUE(a.cam_from_world[c].matrix() == b.cam_from_world[c].matrix());
+
+  // Truncated file: an error naming the file.
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 5);
+  try {
+    ReadBundleAdjustmentProblem(path);
+    ADD_FAILURE() << "truncated file accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "not a problem";
+  }
+  EXPECT_THROW(ReadBundleAdjustmentProblem(path), std::runtime_error);
+  std::filesystem::remove(path);
+  EXPECT_THROW(ReadBundleAdjustmentProblem(path), std::runtime_error);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "ademono/core/options_table.h"
+#include "ademono/feature/grid_fast.h"
 
 namespace ademono {
 namespace {
@@ -275,33 +276,18 @@ void OrbExtractor::Extract(const cv::Mat& image, std::vector<cv::KeyPoint>& keyp
 
     // FAST per grid cell (cells overlap by 6 px so corners on cell edges are seen), falling back
     // to the lower threshold in cells where the initial one finds nothing.
-    const int num_cols = std::max(1, width / kCellSize), num_rows = std::max(1, height / kCellSize);
-    const int cell_w = static_cast<int>(std::ceil(static_cast<double>(width) / num_cols));
-    const int cell_h = static_cast<int>(std::ceil(static_cast<double>(height) / num_rows));
-    std::vector<cv::KeyPoint> candidates;
-    std::vector<cv::KeyPoint> cell_kps;
-    for (int r = 0; r < num_rows; ++r) {
-      const int y0 = min_y + r * cell_h;
-      if (y0 >= max_y - 3) continue;
-      const int y1 = std::min(y0 + cell_h + 6, max_y);
-      for (int c = 0; c < num_cols; ++c) {
-        const int x0 = min_x + c * cell_w;
-        if (x0 >= max_x - 6) continue;
-        const int x1 = std::min(x0 + cell_w + 6, max_x);
-        const cv::Mat cell = level_image(cv::Range(y0, y1), cv::Range(x0, x1));
-        cell_kps.clear();
-        cv::FAST(cell, cell_kps, options_.initial_fast_threshold, true);
-        if (cell_kps.empty()) cv::FAST(cell, cell_kps, options_.min_fast_threshold, true);
-        for (auto& kp : cell_kps) {
-          // Coordinates relative to (min_x, min_y), the distribution region's origin.
-          kp.pt.x += static_cast<float>(x0 - min_x);
-          kp.pt.y += static_cast<float>(y0 - min_y);
-          if (!level_mask.empty() &&
-              level_mask.at<uchar>(cvRound(kp.pt.y) + min_y, cvRound(kp.pt.x) + min_x) == 0)
-            continue;
-          candidates.push_back(kp);
-        }
-      }
+    FastGrid grid;
+    grid.min_x = min_x, grid.min_y = min_y, grid.max_x = max_x, grid.max_y = max_y;
+    grid.num_cols = std::max(1, width / kCellSize);
+    grid.num_rows = std::max(1, height / kCellSize);
+    grid.cell_w = static_cast<int>(std::ceil(static_cast<double>(width) / grid.num_cols));
+    grid.cell_h = static_cast<int>(std::ceil(static_cast<double>(height) / grid.num_rows));
+    std::vector<cv::KeyPoint> candidates = DetectGridFast(
+        level_image, grid, options_.initial_fast_threshold, options_.min_fast_threshold);
+    if (!level_mask.empty()) {
+      std::erase_if(candidates, [&](const cv::KeyPoint& kp) {
+        return level_mask.at<uchar>(cvRound(kp.pt.y) + min_y, cvRound(kp.pt.x) + min_x) == 0;
+      });
     }
     // Overlapping cells report the same corner twice; keep one copy.
     std::sort(candidates.begin(), candidates.end(),

@@ -1,5 +1,8 @@
 #include "ademono/optimize/bundle_adjustment.h"
 
+#include <cstring>
+#include <fstream>
+#include <mutex>
 #include <stdexcept>
 
 #include "ademono/core/options_table.h"
@@ -12,7 +15,14 @@ const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
   static const auto table =
       OptionsTable<B>("mapping")
           .Add("ba_first_iterations", &B::first_iterations, Range::AtLeast(1))
-          .Add("ba_second_iterations", &B::second_iterations, Range::AtLeast(0));
+          .Add("ba_second_iterations", &B::second_iterations, Range::AtLeast(0))
+          .AddChoice<bool>("ba_jacobians", &B::analytic_jacobians,
+                           {{"analytic", true}, {"autodiff", false}})
+          .AddChoice<BaLinearSolver>("ba_linear_solver", &B::linear_solver,
+                                     {{"sparse_schur", BaLinearSolver::kSparseSchur},
+                                      {"dense_schur", BaLinearSolver::kDenseSchur},
+                                      {"iterative_schur", BaLinearSolver::kIterativeSchur}});
+  ;
   return table;
 }
 
@@ -21,8 +31,23 @@ void BundleAdjustmentOptions::Check() const { Table().CheckRanges(*this); }
 namespace {
 
 // Solves with the observations not flagged in `skip`; returns whether Ceres converged.
-bool Solve(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip, int iterations,
-           std::vector<double>& cameras, std::vector<double>& points) {
+std::mutex observer_mutex;
+std::function<void(const BundleAdjustmentProblem&)>& Observer() {
+  static std::function<void(const BundleAdjustmentProblem&)> observer;
+  return observer;
+}
+
+template <int kDim>
+ceres::CostFunction* MakeCost(const BundleAdjustmentOptions& options,
+                              const PinholeIntrinsics& intrinsics, const ImageObservation& image) {
+  if (options.analytic_jacobians) return new internal::AnalyticBaCost<kDim>(intrinsics, image);
+  return new ceres::AutoDiffCostFunction<internal::BaResidual<kDim>, kDim, 6, 3>(
+      new internal::BaResidual<kDim>(intrinsics, image));
+}
+
+bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
+           const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
+           std::vector<double>& points) {
   ceres::Problem ceres_problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<bool> point_used(problem.points.size(), false),
@@ -33,15 +58,11 @@ bool Solve(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip
     double* camera = &cameras[6 * o.camera];
     double* point = &points[3 * o.point];
     if (o.image.HasDepth()) {
-      auto* cost = new ceres::AutoDiffCostFunction<internal::BaResidual<3>, 3, 6, 3>(
-          new internal::BaResidual<3>(problem.intrinsics, o.image));
-      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Stereo)), camera,
-                                     point);
+      ceres_problem.AddResidualBlock(MakeCost<3>(ba, problem.intrinsics, o.image),
+                                     new ceres::HuberLoss(std::sqrt(kChi2Stereo)), camera, point);
     } else {
-      auto* cost = new ceres::AutoDiffCostFunction<internal::BaResidual<2>, 2, 6, 3>(
-          new internal::BaResidual<2>(problem.intrinsics, o.image));
-      ceres_problem.AddResidualBlock(cost, new ceres::HuberLoss(std::sqrt(kChi2Mono)), camera,
-                                     point);
+      ceres_problem.AddResidualBlock(MakeCost<2>(ba, problem.intrinsics, o.image),
+                                     new ceres::HuberLoss(std::sqrt(kChi2Mono)), camera, point);
     }
     point_used[o.point] = true;
     camera_used[o.camera] = true;
@@ -57,7 +78,18 @@ bool Solve(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip
   }
 
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  switch (ba.linear_solver) {
+    case BaLinearSolver::kSparseSchur:
+      options.linear_solver_type = ceres::SPARSE_SCHUR;
+      break;
+    case BaLinearSolver::kDenseSchur:
+      options.linear_solver_type = ceres::DENSE_SCHUR;
+      break;
+    case BaLinearSolver::kIterativeSchur:
+      options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+      options.preconditioner_type = ceres::SCHUR_JACOBI;
+      break;
+  }
   options.linear_solver_ordering = ordering;
   options.max_num_iterations = iterations;
   options.num_threads = 1;
@@ -89,6 +121,10 @@ void ClassifyOutliers(const BundleAdjustmentProblem& problem, const std::vector<
 BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& problem,
                                              const BundleAdjustmentOptions& options) {
   options.Check();
+  {
+    std::lock_guard<std::mutex> lock(observer_mutex);
+    if (Observer()) Observer()(problem);
+  }
   for (const BaObservation& o : problem.observations) {
     if (o.camera >= problem.cameras.size() || o.point >= problem.points.size()) {
       throw std::invalid_argument("bundle adjustment: observation index out of range");
@@ -104,10 +140,12 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
 
   BundleAdjustmentResult result;
   result.outlier.assign(problem.observations.size(), false);
-  result.converged = Solve(problem, result.outlier, options.first_iterations, cameras, points);
+  result.converged =
+      Solve(problem, options, result.outlier, options.first_iterations, cameras, points);
   ClassifyOutliers(problem, cameras, points, result.outlier);
   if (options.second_iterations > 0) {
-    result.converged = Solve(problem, result.outlier, options.second_iterations, cameras, points);
+    result.converged =
+        Solve(problem, options, result.outlier, options.second_iterations, cameras, points);
     ClassifyOutliers(problem, cameras, points, result.outlier);
   }
 
@@ -121,6 +159,98 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
     result.points[p] = Eigen::Vector3d(points[3 * p], points[3 * p + 1], points[3 * p + 2]);
   }
   return result;
+}
+
+void SetBundleAdjustmentObserver(std::function<void(const BundleAdjustmentProblem&)> observer) {
+  std::lock_guard<std::mutex> lock(observer_mutex);
+  Observer() = std::move(observer);
+}
+
+// File layout: magic "ADEMOBA1", intrinsics (5 doubles), then counts (3 uint64) and the cameras
+// (fixed byte, 12 doubles: rotation row-major, translation), points (3 doubles) and observations
+// (camera, point as uint32; u, v, u_right, inv_sigma2, depth_inv_sigma as doubles).
+namespace {
+constexpr char kMagic[8] = {'A', 'D', 'E', 'M', 'O', 'B', 'A', '1'};
+
+template <typename T>
+void Put(std::ofstream& out, T value) {
+  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+template <typename T>
+T Get(std::ifstream& in, const std::string& path) {
+  T value;
+  if (!in.read(reinterpret_cast<char*>(&value), sizeof(T)))
+    throw std::runtime_error(path + ": truncated bundle adjustment problem");
+  return value;
+}
+}  // namespace
+
+void WriteBundleAdjustmentProblem(const BundleAdjustmentProblem& problem, const std::string& path) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  out.write(kMagic, sizeof(kMagic));
+  const PinholeIntrinsics& k = problem.intrinsics;
+  for (double v : {k.fx, k.fy, k.cx, k.cy, k.bf}) Put(out, v);
+  Put<uint64_t>(out, problem.cameras.size());
+  Put<uint64_t>(out, problem.points.size());
+  Put<uint64_t>(out, problem.observations.size());
+  for (const BaCamera& c : problem.cameras) {
+    Put<uint8_t>(out, c.fixed ? 1 : 0);
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 3; ++col) Put(out, c.cam_from_world.linear()(r, col));
+    for (int i = 0; i < 3; ++i) Put(out, c.cam_from_world.translation()[i]);
+  }
+  for (const Eigen::Vector3d& p : problem.points)
+    for (int i = 0; i < 3; ++i) Put(out, p[i]);
+  for (const BaObservation& o : problem.observations) {
+    Put<uint32_t>(out, static_cast<uint32_t>(o.camera));
+    Put<uint32_t>(out, static_cast<uint32_t>(o.point));
+    for (double v : {o.image.pixel.x(), o.image.pixel.y(), o.image.u_right, o.image.inv_sigma2,
+                     o.image.depth_inv_sigma})
+      Put(out, v);
+  }
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+BundleAdjustmentProblem ReadBundleAdjustmentProblem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open bundle adjustment problem");
+  char magic[sizeof(kMagic)];
+  if (!in.read(magic, sizeof(magic)) || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)
+    throw std::runtime_error(path + ": not a bundle adjustment problem (bad magic)");
+  BundleAdjustmentProblem problem;
+  PinholeIntrinsics& k = problem.intrinsics;
+  for (double* v : {&k.fx, &k.fy, &k.cx, &k.cy, &k.bf}) *v = Get<double>(in, path);
+  const auto num_cameras = Get<uint64_t>(in, path), num_points = Get<uint64_t>(in, path),
+             num_observations = Get<uint64_t>(in, path);
+  // Sizes bounded by what the file can hold, so a corrupt count cannot allocate wildly.
+  constexpr uint64_t kLimit = uint64_t{1} << 26;
+  if (num_cameras > kLimit || num_points > kLimit || num_observations > kLimit)
+    throw std::runtime_error(path + ": implausible bundle adjustment problem size");
+  problem.cameras.resize(num_cameras);
+  for (BaCamera& c : problem.cameras) {
+    c.fixed = Get<uint8_t>(in, path) != 0;
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 3; ++col) c.cam_from_world.linear()(r, col) = Get<double>(in, path);
+    for (int i = 0; i < 3; ++i) c.cam_from_world.translation()[i] = Get<double>(in, path);
+  }
+  problem.points.resize(num_points);
+  for (Eigen::Vector3d& p : problem.points)
+    for (int i = 0; i < 3; ++i) p[i] = Get<double>(in, path);
+  problem.observations.resize(num_observations);
+  for (BaObservation& o : problem.observations) {
+    o.camera = Get<uint32_t>(in, path);
+    o.point = Get<uint32_t>(in, path);
+    if (o.camera >= num_cameras || o.point >= num_points)
+      throw std::runtime_error(path + ": observation index out of range");
+    for (double* v : {&o.image.pixel.x(), &o.image.pixel.y(), &o.image.u_right, &o.image.inv_sigma2,
+                      &o.image.depth_inv_sigma})
+      *v = Get<double>(in, path);
+  }
+  if (in.peek() != std::char_traits<char>::eof())
+    throw std::runtime_error(path + ": trailing bytes after the bundle adjustment problem");
+  return problem;
 }
 
 }  // namespace ademono

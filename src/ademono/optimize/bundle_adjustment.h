@@ -5,6 +5,9 @@
 // parameter blocks added in the given order, so results are identical run to run.
 
 #include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
 #include <vector>
 
 #include "ademono/optimize/optimizer_types.h"
@@ -14,11 +17,20 @@ namespace ademono {
 template <typename Options>
 class OptionsTable;
 
+// Ceres' linear solver for the Schur-complemented normal equations (see docs/performance.md for
+// the measured trade-off).
+enum class BaLinearSolver { kSparseSchur, kDenseSchur, kIterativeSchur };
+
 struct BundleAdjustmentOptions {
   int first_iterations = 5;
   int second_iterations = 10;
+  bool analytic_jacobians = true;  // false: Ceres auto-diff (the reference the tests compare to)
+  BaLinearSolver linear_solver = BaLinearSolver::kSparseSchur;
   void Check() const;  // throws std::invalid_argument
-  // Its keys in the flat `mapping:` node: ba_first_iterations, ba_second_iterations.
+  // Its keys in the flat `mapping:` node: ba_first_iterations, ba_second_iterations,
+  // ba_jacobians (analytic|autodiff), ba_linear_solver (sparse_schur|dense_schur|iterative_schur).
+  // Ceres runs on one thread: with 2 its sums are ordered differently and results are no longer
+  // byte-identical (measured, docs/performance.md).
   static const OptionsTable<BundleAdjustmentOptions>& Table();
   bool operator==(const BundleAdjustmentOptions&) const = default;
 };
@@ -51,5 +63,14 @@ struct BundleAdjustmentResult {
 // Throws std::invalid_argument for indices out of range.
 BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& problem,
                                              const BundleAdjustmentOptions& options = {});
+
+// Calls `observer` with every problem SolveBundleAdjustment is given, before solving (null: none).
+// For recording real problems (bench/ba_bench.cpp --record); not meant for production runs.
+void SetBundleAdjustmentObserver(std::function<void(const BundleAdjustmentProblem&)> observer);
+
+// A problem in a compact little-endian binary file (the benchmark's recorded seq-a problem).
+// Read throws std::runtime_error naming the file on a missing, truncated or malformed file.
+void WriteBundleAdjustmentProblem(const BundleAdjustmentProblem& problem, const std::string& path);
+BundleAdjustmentProblem ReadBundleAdjustmentProblem(const std::string& path);
 
 }  // namespace ademono

@@ -12,11 +12,23 @@ const OptionsTable<PoseOptimizerOptions>& PoseOptimizerOptions::Table() {
   static const auto table =
       OptionsTable<P>("optimizer")
           .Add("pose_rounds", &P::rounds, Range::AtLeast(1))
-          .Add("pose_iterations_per_round", &P::iterations_per_round, Range::AtLeast(1));
+          .Add("pose_iterations_per_round", &P::iterations_per_round, Range::AtLeast(1))
+          .AddChoice<bool>("pose_jacobians", &P::analytic_jacobians,
+                           {{"analytic", true}, {"autodiff", false}});
   return table;
 }
 
 void PoseOptimizerOptions::Check() const { Table().CheckRanges(*this); }
+
+namespace {
+template <int kDim>
+ceres::CostFunction* MakeCost(bool analytic, const PinholeIntrinsics& intrinsics,
+                              const PoseObservation& o) {
+  if (analytic) return new internal::AnalyticPoseCost<kDim>(intrinsics, o.image, o.point_world);
+  return new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<kDim>, kDim, 6>(
+      new internal::PoseOnlyResidual<kDim>(intrinsics, o.image, o.point_world));
+}
+}  // namespace
 
 PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
                                     const Rigid3d& initial_cam_from_world,
@@ -48,15 +60,13 @@ PoseOptimizationResult OptimizePose(const PinholeIntrinsics& intrinsics,
       if (result.outlier[i]) continue;
       const PoseObservation& o = observations[i];
       if (o.image.HasDepth()) {
-        auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<3>, 3, 6>(
-            new internal::PoseOnlyResidual<3>(intrinsics, o.image, o.point_world));
-        problem.AddResidualBlock(
-            cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Stereo)) : nullptr, camera);
+        problem.AddResidualBlock(MakeCost<3>(options.analytic_jacobians, intrinsics, o),
+                                 robust ? new ceres::HuberLoss(std::sqrt(kChi2Stereo)) : nullptr,
+                                 camera);
       } else {
-        auto* cost = new ceres::AutoDiffCostFunction<internal::PoseOnlyResidual<2>, 2, 6>(
-            new internal::PoseOnlyResidual<2>(intrinsics, o.image, o.point_world));
-        problem.AddResidualBlock(
-            cost, robust ? new ceres::HuberLoss(std::sqrt(kChi2Mono)) : nullptr, camera);
+        problem.AddResidualBlock(MakeCost<2>(options.analytic_jacobians, intrinsics, o),
+                                 robust ? new ceres::HuberLoss(std::sqrt(kChi2Mono)) : nullptr,
+                                 camera);
       }
       ++added;
     }

@@ -19,8 +19,10 @@ struct PoseOptimizerOptions {
   int rounds = 4;
   int iterations_per_round = 10;
   bool robust_last_round = false;  // ORB-SLAM drops the robust kernel in the last rounds
+  bool analytic_jacobians = true;  // false: Ceres auto-diff
   void Check() const;              // throws std::invalid_argument
-  // The `optimizer:` node: pose_rounds, pose_iterations_per_round (robust_last_round is fixed).
+  // The `optimizer:` node: pose_rounds, pose_iterations_per_round, pose_jacobians
+  // (analytic|autodiff); robust_last_round is fixed.
   static const OptionsTable<PoseOptimizerOptions>& Table();
   bool operator==(const PoseOptimizerOptions&) const = default;
 };

@@ -89,6 +89,116 @@ struct BaResidual : ProjectionResidual<kDim> {
   }
 };
 
+// The same residual with closed-form Jacobians (about 3x cheaper than auto-diff's dual numbers).
+// camera = (omega, t) of cam_from_world: p = R(omega) X + t. With q = R X,
+//   dp/domega = -[q]x J_l(omega),  dp/dt = I,  dp/dX = R,
+// J_l being SO(3)'s left Jacobian. Below Ceres' small-angle threshold AngleAxisRotatePoint uses
+// X + omega x X, whose derivative is -[X]x; the depth clamp has zero derivative, as in auto-diff.
+// `jac_camera` is kDim x 6 and `jac_point` kDim x 3, row-major; either may be null.
+template <int kDim>
+void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
+                        const double* point_world, double* residual, double* jac_camera,
+                        double* jac_point) {
+  double q[3];
+  ceres::AngleAxisRotatePoint(camera, point_world, q);
+  double p[3] = {q[0] + camera[3], q[1] + camera[4], q[2] + camera[5]};
+  const bool clamped = p[2] < 1e-3;
+  if (clamped) p[2] = 1e-3;
+  const double inv_z = 1.0 / p[2];
+  const PinholeIntrinsics& k = r.k;
+  const double pu = k.fx * p[0] * inv_z + k.cx;
+  const double pv = k.fy * p[1] * inv_z + k.cy;
+  residual[0] = r.scale * (pu - r.u);
+  residual[1] = r.scale * (pv - r.v);
+  if constexpr (kDim == 3) residual[2] = r.depth_scale * (pu - k.bf * inv_z - r.ur);
+  if (jac_camera == nullptr && jac_point == nullptr) return;
+
+  using Mat3 = Eigen::Matrix3d;
+  Eigen::Matrix<double, kDim, 3> dr_dp;
+  const double inv_z2 = clamped ? 0.0 : inv_z * inv_z;
+  dr_dp.row(0) << r.scale * k.fx * inv_z, 0.0, -r.scale * k.fx * p[0] * inv_z2;
+  dr_dp.row(1) << 0.0, r.scale * k.fy * inv_z, -r.scale * k.fy * p[1] * inv_z2;
+  if constexpr (kDim == 3)
+    dr_dp.row(2) << r.depth_scale * k.fx * inv_z, 0.0,
+        r.depth_scale * (k.bf - k.fx * p[0]) * inv_z2;
+
+  const Eigen::Map<const Eigen::Vector3d> omega(camera);
+  const double theta2 = omega.squaredNorm();
+  const bool small = !(theta2 > std::numeric_limits<double>::epsilon());  // Ceres' branch
+  auto skew = [](const Eigen::Vector3d& v) {
+    Mat3 m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+  };
+  Mat3 rotation;
+  Mat3 dp_domega;
+  if (small) {
+    const Mat3 omega_x = skew(omega);
+    rotation = Mat3::Identity() + omega_x;
+    dp_domega = -skew(Eigen::Map<const Eigen::Vector3d>(point_world));
+  } else {
+    const double theta = std::sqrt(theta2);
+    // (1 - cos)/theta^2 and (theta - sin)/theta^3, by series where they cancel badly.
+    double a, b;
+    if (theta < 1e-2) {
+      a = 0.5 - theta2 / 24.0 + theta2 * theta2 / 720.0;
+      b = 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
+    } else {
+      a = (1.0 - std::cos(theta)) / theta2;
+      b = (theta - std::sin(theta)) / (theta2 * theta);
+    }
+    const Mat3 omega_x = skew(omega);
+    const Mat3 jl = Mat3::Identity() + a * omega_x + b * omega_x * omega_x;
+    ceres::AngleAxisToRotationMatrix(camera, ceres::ColumnMajorAdapter3x3(rotation.data()));
+    dp_domega = -skew(Eigen::Vector3d(q[0], q[1], q[2])) * jl;
+  }
+  if (jac_camera != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, kDim, 6, Eigen::RowMajor>> j(jac_camera);
+    j.template leftCols<3>() = dr_dp * dp_domega;
+    j.template rightCols<3>() = dr_dp;
+  }
+  if (jac_point != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, kDim, 3, Eigen::RowMajor>> j(jac_point);
+    j = dr_dp * rotation;
+  }
+}
+
+// Bundle adjustment cost with analytic Jacobians (parameter blocks: camera 6, point 3).
+template <int kDim>
+class AnalyticBaCost final : public ceres::SizedCostFunction<kDim, 6, 3> {
+ public:
+  AnalyticBaCost(const PinholeIntrinsics& k, const ImageObservation& obs) : r_(k, obs) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    EvaluateProjection(r_, parameters[0], parameters[1], residuals,
+                       jacobians != nullptr ? jacobians[0] : nullptr,
+                       jacobians != nullptr ? jacobians[1] : nullptr);
+    return true;
+  }
+
+ private:
+  ProjectionResidual<kDim> r_;
+};
+
+// Pose-only cost with analytic Jacobians (parameter block: camera 6; the point is a constant).
+template <int kDim>
+class AnalyticPoseCost final : public ceres::SizedCostFunction<kDim, 6> {
+ public:
+  AnalyticPoseCost(const PinholeIntrinsics& k, const ImageObservation& obs,
+                   const Eigen::Vector3d& point)
+      : r_(k, obs), point_(point) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    EvaluateProjection(r_, parameters[0], point_.data(), residuals,
+                       jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
+    return true;
+  }
+
+ private:
+  ProjectionResidual<kDim> r_;
+  Eigen::Vector3d point_;
+};
+
 // Squared scaled error (chi2) and the camera-frame depth of a point, in plain doubles.
 inline double ObservationChi2(const PinholeIntrinsics& k, const ImageObservation& obs,
                               const Rigid3d& cam_from_world, const Eigen::Vector3d& point_world,

@@ -1,0 +1,126 @@
+// One local bundle adjustment on a real problem recorded from 7-Scenes seq-a (sensor depth,
+// configs/7scenes.yaml), tests/data/ba/seq_a_local_ba.bin, solved with each lever side by side:
+// auto-diff vs analytic Jacobians, Ceres' linear solver, iteration counts. Arguments of BM_LocalBa:
+//   jacobians (0 autodiff, 1 analytic), solver (0 sparse_schur, 1 dense_schur,
+//   2 iterative_schur). Ceres' threads are not a lever: 2 threads change the results' bits.
+// BM_LocalBaIterations varies ba_first_iterations / ba_second_iterations (analytic, sparse).
+//
+// Re-record the problem (the local BA of the last keyframe after --frames frames):
+//   build/release/bench_ba --record=tests/data/ba/seq_a_local_ba.bin --frames=120
+#include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "ademono/depth/depth_factory.h"
+#include "ademono/io/sequence.h"
+#include "ademono/optimize/bundle_adjustment.h"
+#include "ademono/slam/system.h"
+
+namespace {
+
+const std::string kProblemPath =
+    std::string(ADEMONO_SOURCE_DIR) + "/tests/data/ba/seq_a_local_ba.bin";
+
+const ademono::BundleAdjustmentProblem& Problem() {
+  static const ademono::BundleAdjustmentProblem problem =
+      ademono::ReadBundleAdjustmentProblem(kProblemPath);
+  return problem;
+}
+
+void Describe(benchmark::State& state, const ademono::BundleAdjustmentResult& result) {
+  const auto& problem = Problem();
+  int outliers = 0;
+  for (bool o : result.outlier) outliers += o ? 1 : 0;
+  state.counters["cameras"] = static_cast<double>(problem.cameras.size());
+  state.counters["points"] = static_cast<double>(problem.points.size());
+  state.counters["observations"] = static_cast<double>(problem.observations.size());
+  state.counters["outliers"] = outliers;
+}
+
+void BM_LocalBa(benchmark::State& state) {
+  ademono::BundleAdjustmentOptions options;
+  options.analytic_jacobians = state.range(0) != 0;
+  options.linear_solver = static_cast<ademono::BaLinearSolver>(state.range(1));
+  ademono::BundleAdjustmentResult result;
+  for (auto _ : state) {
+    result = ademono::SolveBundleAdjustment(Problem(), options);
+    benchmark::DoNotOptimize(result.points.data());
+  }
+  Describe(state, result);
+}
+BENCHMARK(BM_LocalBa)
+    ->ArgNames({"analytic", "solver"})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({1, 2})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_LocalBaIterations(benchmark::State& state) {
+  ademono::BundleAdjustmentOptions options;
+  options.first_iterations = static_cast<int>(state.range(0));
+  options.second_iterations = static_cast<int>(state.range(1));
+  ademono::BundleAdjustmentResult result;
+  for (auto _ : state) {
+    result = ademono::SolveBundleAdjustment(Problem(), options);
+    benchmark::DoNotOptimize(result.points.data());
+  }
+  Describe(state, result);
+}
+BENCHMARK(BM_LocalBaIterations)
+    ->ArgNames({"first", "second"})
+    ->Args({5, 10})
+    ->Args({5, 5})
+    ->Args({3, 5})
+    ->Unit(benchmark::kMillisecond);
+
+// Runs seq-a frames [0, frames) with configs/7scenes.yaml and writes the last local BA problem.
+int Record(const std::string& path, size_t frames) {
+  const std::string config = std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml";
+  const ademono::SystemOptions options =
+      ademono::SystemOptions::FromYaml(YAML::LoadFile(config), config);
+  auto sequence =
+      ademono::OpenSequence(std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a");
+  ademono::DepthFactoryContext context;
+  context.sequence = sequence.get();
+  auto provider = ademono::MakeDepthProvider("sensor", context);
+  ademono::BundleAdjustmentProblem last;
+  ademono::SetBundleAdjustmentObserver(
+      [&last](const ademono::BundleAdjustmentProblem& problem) { last = problem; });
+  ademono::System system(sequence->GetCamera(), options);
+  for (size_t i = 0; i < frames && i < sequence->Size(); ++i) {
+    const ademono::FrameData frame = sequence->Load(i);
+    system.TrackFrame(frame, provider->Depth(frame, sequence->GetCamera()), {});
+  }
+  ademono::SetBundleAdjustmentObserver(nullptr);
+  if (last.observations.empty()) {
+    std::cerr << "bench_ba: no local bundle adjustment in " << frames << " frames\n";
+    return 2;
+  }
+  ademono::WriteBundleAdjustmentProblem(last, path);
+  std::cout << path << ": " << last.cameras.size() << " cameras, " << last.points.size()
+            << " points, " << last.observations.size() << " observations\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string record;
+  size_t frames = 120;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--record=", 9) == 0) record = argv[i] + 9;
+    if (std::strncmp(argv[i], "--frames=", 9) == 0) frames = std::stoul(argv[i] + 9);
+  }
+  if (!record.empty()) return Record(record, frames);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
