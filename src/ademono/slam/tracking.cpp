@@ -80,6 +80,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       }
     }
     bool odometry_only = false, by_motion = false;
+    // Localisation only: the untouched frame, for the odometry fallback below.
+    std::optional<Frame> pristine;
+    if (localize_only_ && state_ == TrackingState::kOk && velocity_) pristine = frame;
     if (state_ == TrackingState::kOk && localize_only_ && visual_odometry_) {
       // Off the map: odometry on the last frame's temporary points, unless relocalisation
       // (tried on a copy) finds the map again.
@@ -115,6 +118,14 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         frame = std::move(*odometry);
         ok = visual_odometry_ = true;
       }
+    }
+    if (!ok && pristine && !by_motion) {
+      // E.g. just after a relocalisation, the local map was too thin: odometry from the last
+      // frame rather than a lost frame.
+      frame = std::move(*pristine);
+      ok = TrackWithMotionModel(frame);
+      if (ok) visual_odometry_ = true;
+      frame.reference_keyframe = reference_keyframe_;
     }
 
     if (ok) {
