@@ -6,9 +6,7 @@
 
 #include <cereal/archives/portable_binary.hpp>
 #include <cereal/types/array.hpp>
-#include <cereal/types/string.hpp>
 #include <cereal/types/utility.hpp>
-#include <cereal/types/vector.hpp>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -18,10 +16,53 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "ademono/core/error.h"
 
 namespace ademono {
+
+namespace {
+
+// Bytes left in the payload being decoded: a length read from a file is checked against it
+// before anything is allocated (cereal's own vector/string loaders would resize to whatever a
+// corrupt length says). Writing: unbounded.
+thread_local uint64_t t_payload_limit = std::numeric_limits<uint64_t>::max();
+
+void CheckLength(uint64_t count, uint64_t min_element_bytes) {
+  if (count > t_payload_limit / std::max<uint64_t>(1, min_element_bytes))
+    throw std::runtime_error("a length of " + std::to_string(count) + " exceeds the payload");
+}
+
+// The same bytes as cereal's std::vector / std::string serialisation (size tag, then the
+// elements; arithmetic ones as one block), with the length checked on load.
+template <class Archive, class T>
+void Elements(Archive& ar, std::vector<T>& v, uint64_t min_element_bytes) {
+  cereal::size_type n = v.size();
+  ar(cereal::make_size_tag(n));
+  if constexpr (Archive::is_loading::value) {
+    CheckLength(n, min_element_bytes);
+    v.resize(static_cast<size_t>(n));
+  }
+  if constexpr (std::is_arithmetic_v<T>) {
+    ar(cereal::binary_data(v.data(), static_cast<size_t>(n) * sizeof(T)));
+  } else {
+    for (auto& x : v) ar(x);
+  }
+}
+
+template <class Archive>
+void Text(Archive& ar, std::string& s) {
+  cereal::size_type n = s.size();
+  ar(cereal::make_size_tag(n));
+  if constexpr (Archive::is_loading::value) {
+    CheckLength(n, 1);
+    s.resize(static_cast<size_t>(n));
+  }
+  ar(cereal::binary_data(s.data(), static_cast<size_t>(n)));
+}
+
+}  // namespace
 
 template <class Archive>
 void serialize(Archive& ar, MapKeyPointRecord& k) {
@@ -30,15 +71,20 @@ void serialize(Archive& ar, MapKeyPointRecord& k) {
 
 template <class Archive>
 void serialize(Archive& ar, MapKeyFrameRecord& k) {
-  ar(k.id, k.frame_id, k.index, k.timestamp, k.cam_from_world, k.keypoints, k.descriptors, k.depth,
-     k.bf, k.close_depth, k.depth_error_relative, k.depth_error_per_metre,
-     k.weight_by_error_model, k.depth_scale, k.parent, k.connections);
+  ar(k.id, k.frame_id, k.index, k.timestamp, k.cam_from_world);
+  Elements(ar, k.keypoints, 24);
+  Elements(ar, k.descriptors, 1);
+  Elements(ar, k.depth, 4);
+  ar(k.bf, k.close_depth, k.depth_error_relative, k.depth_error_per_metre,
+     k.weight_by_error_model, k.depth_scale, k.parent);
+  Elements(ar, k.connections, 12);
 }
 
 template <class Archive>
 void serialize(Archive& ar, MapPointRecord& p) {
   ar(p.id, p.position, p.normal, p.descriptor, p.min_distance, p.max_distance, p.reference,
-     p.first_keyframe_id, p.first_frame_id, p.visible, p.found, p.dynamic_hits, p.observations);
+     p.first_keyframe_id, p.first_frame_id, p.visible, p.found, p.dynamic_hits);
+  Elements(ar, p.observations, 12);
 }
 
 template <class Archive>
@@ -48,7 +94,11 @@ void serialize(Archive& ar, Camera& c) {
 
 template <class Archive>
 void serialize(Archive& ar, MapFileData& d) {
-  ar(d.camera, d.options_yaml, d.next_keyframe_id, d.next_point_id, d.keyframes, d.points);
+  ar(d.camera);
+  Text(ar, d.options_yaml);
+  ar(d.next_keyframe_id, d.next_point_id);
+  Elements(ar, d.keyframes, 100);
+  Elements(ar, d.points, 140);
 }
 
 namespace {
@@ -117,7 +167,8 @@ void Validate(const MapFileData& d, const std::filesystem::path& path) {
     for (double v : k.cam_from_world)
       if (!Finite(v)) fail(where + "pose is not finite");
     for (const auto& kp : k.keypoints) {
-      if (!Finite(kp.x) || !Finite(kp.y) || kp.octave < 0 || kp.octave > 64)
+      if (!Finite(kp.x) || !Finite(kp.y) || !Finite(kp.size) || !Finite(kp.response) ||
+          !(kp.angle >= -1.f && kp.angle <= 360.f) || kp.octave < 0)
         fail(where + "bad keypoint");
     }
     for (float z : k.depth)
@@ -258,6 +309,10 @@ MapFileData ParseMapFile(const std::string& bytes, const std::filesystem::path& 
   if (Crc32(bytes.data() + kMapHeaderSize, payload_size) != crc)
     ThrowInputError(path, "checksum mismatch (the map file is corrupt)");
   MapFileData data;
+  struct LimitGuard {
+    explicit LimitGuard(uint64_t limit) { t_payload_limit = limit; }
+    ~LimitGuard() { t_payload_limit = std::numeric_limits<uint64_t>::max(); }
+  } guard(payload_size);
   try {
     std::istringstream in(bytes.substr(kMapHeaderSize), std::ios::binary);
     cereal::PortableBinaryInputArchive archive(in);
@@ -359,8 +414,17 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
 }
 
 void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyramid>& pyramid,
-                Map& map) {
+                Map& map, const std::filesystem::path& path_for_errors) {
   if (map.NumKeyFrames() != 0) throw std::logic_error("RestoreMap: the map is not empty");
+  for (const auto& r : data.keyframes) {
+    for (const auto& k : r.keypoints) {
+      if (k.octave >= pyramid->num_levels)
+        ThrowInputError(path_for_errors,
+                        "keyframe " + std::to_string(r.id) + ": keypoint on pyramid level " +
+                            std::to_string(k.octave) + ", the ORB options have " +
+                            std::to_string(pyramid->num_levels) + " levels");
+    }
+  }
   std::map<uint64_t, KeyFrame*> keyframes;
   for (const auto& r : data.keyframes) {
     std::vector<cv::KeyPoint> keypoints;

@@ -88,7 +88,8 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
 
 // Rebuilds keyframes (features, grid), points, observations, covisibility and the spanning tree
 // into an empty `map` (its keyframe database is filled too). The caller holds map.mutex.
+// InputError naming `path_for_errors` when a keypoint's level is beyond `pyramid`.
 void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyramid>& pyramid,
-                Map& map);
+                Map& map, const std::filesystem::path& path_for_errors = {});
 
 }  // namespace ademono

@@ -64,7 +64,7 @@ void System::LoadMap(const std::filesystem::path& path, bool localize_only) {
   }
   std::lock_guard<std::mutex> lock(map_.mutex);
   if (map_.NumKeyFrames() != 0) throw std::logic_error("System::LoadMap: the map is not empty");
-  RestoreMap(data, pyramid_, map_);
+  RestoreMap(data, pyramid_, map_, path);
   tracking_.StartInLoadedMap(localize_only);
 }
 
