@@ -1,7 +1,7 @@
 // Map files (ParseMapFile, then RestoreMap into a map with a keyframe database). The CRC-32 in
-// the header stops almost every mutation before the decoder, so an input whose first byte is odd
-// is taken as a payload and wrapped in a valid header: the cereal decoder, the length guards,
-// Validate and RestoreMap see arbitrary bytes too.
+// the header stops almost every mutation before the decoder, so an input that does not start
+// with the magic is taken as a payload and wrapped in a valid header: the cereal decoder, the
+// length guards, Validate and RestoreMap see arbitrary bytes too.
 #include <zlib.h>
 
 #include "ademono/slam/map_io.h"
@@ -10,8 +10,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ademono;
   std::string bytes(reinterpret_cast<const char*>(data), size);
-  if (size > 0 && (data[0] & 1) != 0) {
-    const std::string payload = bytes.substr(1);
+  if (bytes.compare(0, 8, std::string("ADEMAP\r\n", 8)) != 0) {
+    const std::string payload = bytes;
     std::string header("ADEMAP\r\n", 8);
     auto put = [&header](uint64_t v, int n) {
       for (int i = 0; i < n; ++i) header.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
