@@ -86,3 +86,39 @@ metres = rng.uniform(0.2, 9.0, size=(6, 8)).astype(np.float32)
 metres[0, 0] = np.nan
 ok, tiff = cv2.imencode(".tiff", metres)
 seed("depth_image", "metres32.tiff", b"\1" + tiff.tobytes())
+
+# Map files (map_file): a two-keyframe map in the layout of slam/map_io.h (cereal portable binary:
+# a byte 1 for little-endian, then the fields; lengths as uint64), once as a whole file and once
+# as a bare payload (the target wraps inputs without the magic in a valid header).
+import struct
+import zlib
+
+
+def map_payload():
+    b = bytearray(b"\x01")
+    b += struct.pack("<ii4d5d", 640, 480, 585.0, 585.0, 320.0, 240.0, 0, 0, 0, 0, 0)
+    options = b"orb:\n  num_features: 1000\n"
+    b += struct.pack("<Q", len(options)) + options
+    b += struct.pack("<QQ", 2, 1)  # next keyframe id, next point id
+    b += struct.pack("<Q", 2)
+    for k in range(2):
+        b += struct.pack("<QQQd", k, k, k, k / 30.0)
+        b += struct.pack("<12d", 1, 0, 0, 0.05 * k, 0, 1, 0, 0, 0, 0, 1, 0)
+        b += struct.pack("<Q", 3)
+        for i in range(3):
+            b += struct.pack("<5fi", 100.0 + 50 * i, 120.0 + 10 * k, 31.0, 45.0, 0.001, 0)
+        b += struct.pack("<Q", 96) + bytes((i * 7 + k) % 256 for i in range(96))
+        b += struct.pack("<Q", 3) + struct.pack("<3f", 1.5, 2.0, -1.0)
+        b += struct.pack("<dfdd?fq", 0.08 * 585, 3.2, 0.0, 0.0, True, 1.0, k - 1)
+        b += struct.pack("<Q", 1) + struct.pack("<Qi", 1 - k, 15)
+    b += struct.pack("<Q", 1)
+    b += struct.pack("<Q3d3d", 0, 0.1, 0.2, 1.5, 0, 0, 1) + bytes(range(32))
+    b += struct.pack("<ffQQQiii", 0.5, 3.0, 0, 0, 0, 2, 2, 0)
+    b += struct.pack("<Q", 2) + struct.pack("<QI", 0, 0) + struct.pack("<QI", 1, 0)
+    return bytes(b)
+
+
+payload = map_payload()
+seed("map_file", "two_keyframes.map",
+     b"ADEMAP\r\n" + struct.pack("<IQI", 1, len(payload), zlib.crc32(payload)) + payload)
+seed("map_file", "two_keyframes.payload", payload)

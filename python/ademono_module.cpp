@@ -539,6 +539,18 @@ PYBIND11_MODULE(ademono, m) {
            "(default: the frame number); detections: list of Detection")
       .def("shutdown", &PySystem::Shutdown)
       .def(
+          "save_map", [](PySystem& s, const fs::path& path) { s.Get().SaveMap(path); },
+          py::arg("path"),
+          "Finishes local mapping and writes the map as `ademono run --save-map` (docs/maps.md)")
+      .def(
+          "load_map",
+          [](PySystem& s, const fs::path& path, bool localize_only) {
+            s.Get().LoadMap(path, localize_only);
+          },
+          py::arg("path"), py::arg("localize_only") = false,
+          "Before the first frame: start from a saved map (relocalise in it; localize_only: "
+          "never change it)")
+      .def(
           "trajectory", [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
           "(timestamps (N,), world_from_cam (N, 4, 4)) of the tracked frames")
       .def(

@@ -231,3 +231,25 @@ def test_example_script_writes_a_plot(tmp_path):
     assert image is not None and image.shape[0] > 300 and image.shape[1] > 600
     # Something was drawn: not a blank canvas.
     assert (image < 200).mean() > 0.01
+
+
+@needs_shared
+def test_save_map_then_localize_only_leaves_the_file(tmp_path):
+    seq = ademono.open_sequence(f"7scenes:{SEQ_A}")
+    config = str(REPO / "configs" / "7scenes.yaml")
+    first = ademono.System(config, seq.camera)
+    for i in range(40):
+        first.track(seq[i].image, depth=seq[i].depth, timestamp=seq[i].timestamp)
+    first.save_map(tmp_path / "a.map")
+    saved = (tmp_path / "a.map").read_bytes()
+    second = ademono.System(config, seq.camera)
+    second.load_map(tmp_path / "a.map", localize_only=True)
+    states = [second.track(seq[i].image, depth=seq[i].depth, timestamp=seq[i].timestamp).state
+              for i in range(40, 50)]
+    assert states == ["ok"] * 10
+    assert second.num_keyframes == first.num_keyframes
+    second.save_map(tmp_path / "b.map")
+    assert (tmp_path / "b.map").read_bytes() == saved
+    (tmp_path / "bad.map").write_bytes(saved[:100])
+    with pytest.raises(ademono.InputError, match="truncated"):
+        ademono.System(config, seq.camera).load_map(tmp_path / "bad.map")

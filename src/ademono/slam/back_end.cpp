@@ -2,16 +2,23 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
 
+#include "ademono/core/error.h"
 #include "ademono/core/timing.h"
+#include "ademono/slam/map_io.h"
 
 namespace ademono {
 
 BackEnd::BackEnd(const Camera& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
+      keyframe_database_(options.place),
       local_mapping_(map_, options.mapping),
-      tracking_(map_, local_mapping_, options) {}
+      tracking_(map_, local_mapping_, options) {
+  map_.SetKeyFrameDatabase(&keyframe_database_);
+}
 
 BackEnd::~BackEnd() { Shutdown(); }
 
@@ -19,6 +26,50 @@ void BackEnd::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   local_mapping_.Shutdown();
+}
+
+namespace {
+
+bool SameCamera(const Camera& a, const Camera& b) {
+  auto close = [](double x, double y) { return std::abs(x - y) <= 1e-6 * std::max(1.0, std::abs(x)); };
+  if (a.width != b.width || a.height != b.height) return false;
+  if (!close(a.fx, b.fx) || !close(a.fy, b.fy) || !close(a.cx, b.cx) || !close(a.cy, b.cy))
+    return false;
+  for (size_t i = 0; i < a.distortion.size(); ++i)
+    if (!close(a.distortion[i], b.distortion[i])) return false;
+  return true;
+}
+
+std::string CameraText(const Camera& c) {
+  std::ostringstream o;
+  o << c.width << "x" << c.height << " fx " << c.fx << " fy " << c.fy << " cx " << c.cx << " cy "
+    << c.cy;
+  return o.str();
+}
+
+}  // namespace
+
+void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
+                      const std::shared_ptr<const ScalePyramid>& pyramid) {
+  const MapFileData data = LoadMapFile(path);
+  if (!SameCamera(data.camera, camera_)) {
+    ThrowInputError(path, "the map's camera (" + CameraText(data.camera) +
+                              ") does not match the sequence's (" + CameraText(camera_) + ")");
+  }
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  if (map_.NumKeyFrames() != 0) throw std::logic_error("BackEnd::LoadMap: the map is not empty");
+  RestoreMap(data, pyramid, map_, path);
+  tracking_.StartInLoadedMap(localize_only);
+}
+
+void BackEnd::SaveMap(const std::filesystem::path& path) {
+  Shutdown();
+  MapFileData data;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    data = MapToRecords(map_, camera_, options_);
+  }
+  SaveMapFile(path, data);
 }
 
 void BackEnd::HandOff(size_t frame_index) { local_mapping_.HandOff(frame_index); }
@@ -68,7 +119,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
     // background the box covers).
     if (out.tracked && !depth.empty() && options_.filter.enable_dynamic_removal &&
-        !filtered.moving_detections.empty())
+        !tracking_.LocalizeOnly() && !filtered.moving_detections.empty())
       out.dynamic_points_culled +=
           CullPointsOnMovingObjects(out.cam_from_world, depth, filtered.moving_detections);
     result.state = tracking_.State();

@@ -3,6 +3,7 @@
 // keyframe decision), culling of map points on moving objects, and local mapping; it owns the
 // map and answers every question about it (trajectories, point cloud, counts).
 
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
 #include "ademono/perception/detection.h"
+#include "ademono/place/keyframe_database.h"
 #include "ademono/slam/front_end.h"
 #include "ademono/slam/local_mapping.h"
 #include "ademono/slam/map.h"
@@ -51,6 +53,16 @@ class BackEnd {
   // Finishes local mapping. Idempotent.
   void Shutdown();
 
+  // Map reuse (docs/maps.md). LoadMap: before the first frame; restores a saved map (InputError
+  // naming the file for a bad map or a camera that differs from this system's), then the first
+  // frames relocalise in it. With `localize_only` the map is never changed. SaveMap finishes
+  // local mapping (Shutdown) and writes the map atomically.
+  void LoadMap(const std::filesystem::path& path, bool localize_only,
+               const std::shared_ptr<const ScalePyramid>& pyramid);
+  void SaveMap(const std::filesystem::path& path);
+  // Place recognition index of the live keyframes (thread-safe on its own).
+  const KeyFrameDatabase& GetKeyFrameDatabase() const { return keyframe_database_; }
+
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
   std::vector<std::pair<size_t, double>> DepthScales() const;
@@ -68,6 +80,9 @@ class BackEnd {
 
   Camera camera_;
   SystemOptions options_;
+  // Place recognition over the live keyframes (the map adds and erases them); declared before
+  // the map so it outlives the map's pointer to it.
+  KeyFrameDatabase keyframe_database_;
   mutable Map map_;  // mutable: const accessors lock its mutex
   LocalMapping local_mapping_;
   Tracking tracking_;

@@ -61,6 +61,9 @@ class FrontEnd {
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
                                            const cv::Mat& depth, const FrameDepthOptions& options);
 
+  // The scale pyramid of every frame's keypoints (restored keyframes of a loaded map share it).
+  const std::shared_ptr<const ScalePyramid>& Pyramid() const { return pyramid_; }
+
  private:
   Camera camera_;
   SystemOptions options_;

@@ -55,6 +55,12 @@ class System {
   // Finishes local mapping (threaded mode). Idempotent.
   void Shutdown();
 
+  // Map reuse (docs/maps.md), see BackEnd::LoadMap and BackEnd::SaveMap.
+  void LoadMap(const std::filesystem::path& path, bool localize_only) {
+    back_end_.LoadMap(path, localize_only, front_end_.Pyramid());
+  }
+  void SaveMap(const std::filesystem::path& path) { back_end_.SaveMap(path); }
+
   // Pose of every tracked input frame, resolved against the current keyframe poses.
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
@@ -69,6 +75,8 @@ class System {
   int NumTracked() const;
   const Camera& GetCamera() const { return camera_; }
   const SystemOptions& Options() const { return options_; }
+  // Place recognition index of the live keyframes (thread-safe on its own).
+  const KeyFrameDatabase& GetKeyFrameDatabase() const { return back_end_.GetKeyFrameDatabase(); }
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,

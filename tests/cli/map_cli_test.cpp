@@ -1,0 +1,119 @@
+// `ademono run --save-map / --load-map [--localize-only]` and `ademono map info` on 7-Scenes:
+// a map of frames 0-59, then frames 60-119 localised in it in a second process.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cli_test_util.h"
+
+namespace fs = std::filesystem;
+using ademono::cli_test::CliResult;
+using ademono::cli_test::ReadFile;
+using ademono::cli_test::RunCli;
+
+namespace {
+
+std::string Dataset() { return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a"; }
+std::string Config() { return std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml"; }
+
+std::string Bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+class MapCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("ademono_map_cli_" + std::to_string(::getpid())));
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_);
+    const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                               " --frames 0:60 --save-map " + MapPath().string() + " --out " +
+                               (*dir_ / "first").string());
+    ASSERT_EQ(r.code, 0) << r.out;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static fs::path MapPath() { return *dir_ / "seq-a-0-60.map"; }
+  static fs::path* dir_;
+};
+fs::path* MapCliTest::dir_ = nullptr;
+
+TEST_F(MapCliTest, LocalizeOnlyTracksEveryFrameWithinTheBoundAndLeavesTheFile) {
+  ASSERT_TRUE(fs::exists(MapPath()));
+  const std::string before = Bytes(MapPath());
+  const fs::path out = *dir_ / "second";
+  const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                             " --frames 60:120 --load-map " + MapPath().string() +
+                             " --localize-only --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["frames"], 60);
+  EXPECT_EQ(summary["tracked"], 60);
+  EXPECT_LE(summary["accuracy"]["ate_se3_rmse_m"].get<double>(), 0.04);
+  const auto first = nlohmann::json::parse(ReadFile(*dir_ / "first" / "summary.json"));
+  EXPECT_EQ(summary["keyframes"], first["keyframes"]);  // no keyframe added
+  EXPECT_TRUE(Bytes(MapPath()) == before);
+}
+
+TEST_F(MapCliTest, MapInfoPrintsWhatTheMapHolds) {
+  const CliResult r = RunCli("map info " + MapPath().string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("format version: 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("camera: 640x480 fx 585"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("keyframes: "), std::string::npos);
+  EXPECT_NE(r.out.find("map points: "), std::string::npos);
+  EXPECT_NE(r.out.find("bounding box"), std::string::npos);
+}
+
+TEST_F(MapCliTest, BadMapsExitTwoWithOneLineNamingTheFile) {
+  const std::string good = Bytes(MapPath());
+  std::string version = good, flipped = good;
+  version[8] = 9;
+  flipped[good.size() - 100] ^= 0x01;
+  const fs::path camera = *dir_ / "camera.yaml";
+  std::ofstream(camera) << "width: 640\nheight: 480\nfx: 600\nfy: 600\ncx: 320\ncy: 240\n";
+  struct Case {
+    std::string name, bytes, extra, needle;
+  };
+  const std::vector<Case> cases = {
+      {"truncated", good.substr(0, good.size() - 1000), "", "truncated"},
+      {"version", version, "", "version 9"},
+      {"checksum", flipped, "", "checksum mismatch"},
+      {"camera", good, " --camera " + camera.string(), "does not match the sequence"},
+  };
+  for (const Case& c : cases) {
+    const fs::path bad = *dir_ / (c.name + ".map");
+    std::ofstream(bad, std::ios::binary) << c.bytes;
+    const fs::path out = *dir_ / ("out_" + c.name);
+    const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                               " --frames 60:62 --load-map " + bad.string() + c.extra +
+                               " --localize-only --out " + out.string());
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.out;
+    EXPECT_NE(r.out.find(bad.string()), std::string::npos) << c.name << ": " << r.out;
+    EXPECT_NE(r.out.find(c.needle), std::string::npos) << c.name << ": " << r.out;
+    // One error line (the config lookup also logs an [info] line).
+    size_t errors = 0;
+    for (size_t at = r.out.find("error:"); at != std::string::npos; at = r.out.find("error:", at + 1))
+      ++errors;
+    EXPECT_EQ(errors, 1u) << c.name << ": " << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.name << ": partial output";
+    if (c.name != "camera") {
+      const CliResult info = RunCli("map info " + bad.string());
+      EXPECT_EQ(info.code, 2) << info.out;
+      EXPECT_NE(info.out.find(c.needle), std::string::npos) << info.out;
+    }
+  }
+  const CliResult r = RunCli("run --dataset " + Dataset() + " --frames 0:2 --localize-only --out " +
+                             (*dir_ / "x").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--localize-only needs --load-map"), std::string::npos) << r.out;
+}
+
+}  // namespace

@@ -1,0 +1,210 @@
+#include "ademono/slam/map_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "ademono/core/error.h"
+#include "ademono/slam/system.h"
+#include "slam_test_util.h"
+
+namespace ademono {
+namespace {
+
+namespace fs = std::filesystem;
+using testing_util::Slice;
+
+SystemOptions TestOptions() {
+  SystemOptions options;
+  options.depth.min_depth = 0.3;
+  options.depth.max_depth = 6.0;
+  return options;
+}
+
+void Track(System& system, const Sequence& sequence, std::vector<TrackResult>* results = nullptr) {
+  for (size_t i = 0; i < sequence.Size(); ++i) {
+    const FrameData frame = sequence.Load(i);
+    cv::Mat depth = frame.depth.clone();
+    depth.forEach<float>([](float& z, const int*) {
+      if (!std::isfinite(z) || z < 0.f) z = 0.f;
+    });
+    const TrackResult r = system.TrackFrame(frame, depth, {});
+    if (results != nullptr) results->push_back(r);
+  }
+  system.Shutdown();
+}
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+class MapIoTest : public ::testing::Test {
+ protected:
+  // One map of 7-Scenes frames 0-59, built once for the whole suite.
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::temp_directory_path() / ("ademono_map_io_" + std::to_string(::getpid())));
+    fs::create_directories(*dir_);
+    const auto sequence = Slice(0, 60);
+    System system(sequence->GetCamera(), TestOptions());
+    Track(system, *sequence);
+    system.SaveMap(MapPath());
+    keyframes_ = system.NumKeyFrames();
+    points_ = system.NumMapPoints();
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static fs::path MapPath() { return *dir_ / "a.map"; }
+  static fs::path* dir_;
+  static size_t keyframes_, points_;
+};
+fs::path* MapIoTest::dir_ = nullptr;
+size_t MapIoTest::keyframes_ = 0, MapIoTest::points_ = 0;
+
+// The ground truth of frame i in the first session's world (its first camera).
+Rigid3d GroundTruthInFirstSession(const Sequence& full, size_t i) {
+  return full.Load(0).world_from_cam_gt->inverse() * *full.Load(i).world_from_cam_gt;
+}
+
+TEST_F(MapIoTest, SaveLoadSaveIsByteIdentical) {
+  const MapFileData data = LoadMapFile(MapPath());
+  EXPECT_EQ(data.keyframes.size(), keyframes_);
+  EXPECT_EQ(data.points.size(), points_);
+  EXPECT_GT(keyframes_, 1u);
+  System system(Slice(0, 1)->GetCamera(), TestOptions());
+  system.LoadMap(MapPath(), true);
+  EXPECT_EQ(system.NumKeyFrames(), keyframes_);
+  EXPECT_EQ(system.NumMapPoints(), points_);
+  EXPECT_EQ(system.GetKeyFrameDatabase().Size(), keyframes_);
+  const fs::path again = *dir_ / "again.map";
+  system.SaveMap(again);
+  EXPECT_TRUE(ReadBytes(again) == ReadBytes(MapPath()));
+}
+
+TEST_F(MapIoTest, LocalizeOnlyRelocalisesEveryFrameAndNeverChangesTheMap) {
+  const std::string before = ReadBytes(MapPath());
+  // Frames 60-89: after the map's frames.
+  const auto sequence = Slice(60, 90);
+  const auto full = Slice(0, 90);
+  auto run = [&] {
+    System system(sequence->GetCamera(), TestOptions());
+    system.LoadMap(MapPath(), true);
+    std::vector<TrackResult> results;
+    Track(system, *sequence, &results);
+    EXPECT_TRUE(results.front().relocalised);
+    for (const TrackResult& r : results) {
+      EXPECT_TRUE(r.tracked) << r.index;
+      EXPECT_FALSE(r.new_keyframe);
+    }
+    EXPECT_EQ(system.NumKeyFrames(), keyframes_);
+    EXPECT_EQ(system.NumMapPoints(), points_);
+    const fs::path after = *dir_ / "after_localize.map";
+    system.SaveMap(after);
+    EXPECT_TRUE(ReadBytes(after) == before) << "the map changed in localisation-only mode";
+    return system.FrameTrajectory();
+  };
+  const Trajectory a = run();
+  ASSERT_EQ(a.size(), 30u);
+  double worst = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    const Rigid3d gt = GroundTruthInFirstSession(*full, 60 + k);
+    worst = std::max(worst, (gt.translation() - a[k].world_from_cam.translation()).norm());
+  }
+  EXPECT_LT(worst, 0.05);  // in the first session's frame, no alignment
+  const Trajectory b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i)
+    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+  EXPECT_TRUE(ReadBytes(MapPath()) == before);
+}
+
+TEST_F(MapIoTest, WithoutLocalizeOnlyTheLoadedMapIsExtended) {
+  const auto sequence = Slice(60, 90);
+  System system(sequence->GetCamera(), TestOptions());
+  system.LoadMap(MapPath(), false);
+  std::vector<TrackResult> results;
+  Track(system, *sequence, &results);
+  int tracked = 0;
+  for (const TrackResult& r : results) tracked += r.tracked;
+  EXPECT_EQ(tracked, 30);
+  EXPECT_GT(system.NumKeyFrames(), keyframes_);
+}
+
+TEST_F(MapIoTest, BadMapsFailWithOneLineNamingTheFile) {
+  const std::string good = ReadBytes(MapPath());
+  auto expect_error = [&](const std::string& bytes, const std::string& needle) {
+    const fs::path bad = *dir_ / "bad.map";
+    WriteBytes(bad, bytes);
+    try {
+      LoadMapFile(bad);
+      ADD_FAILURE() << "no error for " << needle;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(bad.string()), std::string::npos) << message;
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  };
+  expect_error(good.substr(0, good.size() / 2), "truncated");
+  expect_error(good.substr(0, 12), "truncated");
+  expect_error("", "bad magic");
+  expect_error("hello world, not a map at all", "bad magic");
+  std::string version = good;
+  version[8] = 7;
+  expect_error(version, "version 7");
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x10;
+  expect_error(flipped, "checksum mismatch");
+  expect_error(good + "x", "bytes after the payload");
+  try {
+    LoadMapFile(*dir_ / "missing.map");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos);
+  }
+  // A consistent file whose payload refers to a keyframe that does not exist.
+  MapFileData data = LoadMapFile(MapPath());
+  data.points.front().observations.front().first = 999999;
+  expect_error(SerializeMapFile(data), "unknown keyframe");
+}
+
+TEST_F(MapIoTest, CameraThatDiffersFromTheSequenceIsRejected) {
+  Camera other = Slice(0, 1)->GetCamera();
+  other.fx += 10;
+  System system(other, TestOptions());
+  try {
+    system.LoadMap(MapPath(), true);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not match the sequence"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(system.NumKeyFrames(), 0u);
+}
+
+TEST_F(MapIoTest, SummaryCountsWhatTheMapHolds) {
+  const MapFileData data = LoadMapFile(MapPath());
+  const MapFileSummary s = SummarizeMap(data, fs::file_size(MapPath()));
+  EXPECT_EQ(s.num_keyframes, keyframes_);
+  EXPECT_EQ(s.num_points, points_);
+  EXPECT_GE(s.num_observations, points_);
+  EXPECT_TRUE((s.min_corner.array() < s.max_corner.array()).all());
+  const std::string text = MapSummaryText(MapPath(), s);
+  EXPECT_NE(text.find("format version: 1"), std::string::npos);
+  EXPECT_NE(text.find("keyframes: " + std::to_string(keyframes_)), std::string::npos);
+  EXPECT_NE(text.find("tracking:"), std::string::npos);  // the options
+}
+
+}  // namespace
+}  // namespace ademono
