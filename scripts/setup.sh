@@ -37,7 +37,7 @@ fi
 apt_packages=(
   build-essential cmake ninja-build pkg-config ccache
   libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev
-  libspdlog-dev libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libspdlog-dev libfmt-dev nlohmann-json3-dev libcereal-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
   python3-dev pybind11-dev python3-matplotlib
   chromium

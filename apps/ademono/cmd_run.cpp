@@ -38,6 +38,8 @@ struct RunArgs : SequenceRunArgs {
   bool no_dynamic_removal = false;
   bool no_distant_filter = false;
   bool threaded = false;
+  std::string save_map, load_map;
+  bool localize_only = false;
 };
 
 // The filter's view of the frame (boxes as the filter grew them, keypoints by label, legend).
@@ -51,6 +53,8 @@ void WriteViz(const fs::path& dir, const FrameData& frame, const std::vector<Det
 
 int Run(const RunArgs& args) {
   if (args.out.empty()) throw InputError("--out is required");
+  if (args.localize_only && args.load_map.empty())
+    throw InputError("--localize-only needs --load-map FILE");
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
@@ -75,6 +79,9 @@ int Run(const RunArgs& args) {
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &run.pipeline.start, &run.pipeline.end);
   run.pipeline.overlap = !args.no_overlap;
+  run.load_map = args.load_map;
+  run.localize_only = args.localize_only;
+  run.save_map = args.save_map;
 
   DepthFactoryContext context;
   context.sequence = sequence.get();
@@ -109,6 +116,9 @@ int Run(const RunArgs& args) {
     }
   };
   const RunReport report = RunSequence(*sequence, depth.get(), detector.get(), run);
+  if (report.trajectory.empty() && !args.load_map.empty()) {
+    throw InputError(args.dataset + ": no frame could be relocalised in the map " + args.load_map);
+  }
   if (report.trajectory.empty()) {
     throw InputError(
         args.dataset +
@@ -147,6 +157,12 @@ const bool kRegistered = RegisterCommand(
       app.add_flag(
           "--threaded", args->threaded,
           "local mapping in its own thread (faster wall time, not reproducible run to run)");
+      app.add_option("--save-map", args->save_map,
+                     "write the final map to FILE (docs/maps.md; atomic, versioned, checksummed)");
+      app.add_option("--load-map", args->load_map,
+                     "start from the map in FILE: relocalise in it, then extend it");
+      app.add_flag("--localize-only", args->localize_only,
+                   "with --load-map: track against the loaded map without ever changing it");
       return [args] { return Run(*args); };
     });
 

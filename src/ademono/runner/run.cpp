@@ -137,6 +137,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   report.detector_options = options.detector;
 
   System system(sequence.GetCamera(), options.system);
+  if (!options.load_map.empty()) system.LoadMap(options.load_map, options.localize_only);
   const SyntheticTruth truth(sequence.Path());
   const bool score = options.score_synthetic_truth && truth.Available();
   if (score) report.truth = TruthCounts{};
@@ -163,6 +164,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   };
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
   system.Shutdown();
+  if (!options.save_map.empty()) system.SaveMap(options.save_map);
 
   // The pipeline measured depth and detection (prepared ahead); the rest came with each frame.
   for (size_t i = 0; i < report.per_frame.size() && i < run.timings.size(); ++i)

@@ -82,6 +82,11 @@ struct RunOptions {
   DetectorOptions detector;  // the config's `detector:` node, for config.resolved.yaml
   // Score the filter labels against masks/ when the sequence has them (synthetic sequences).
   bool score_synthetic_truth = false;
+  // Map reuse (docs/maps.md): a saved map to start from (relocalise in it; with localize_only
+  // never change it) and where to save the final map. Empty paths: none.
+  std::filesystem::path load_map;
+  bool localize_only = false;
+  std::filesystem::path save_map;
   // Called after each frame, in order, on the calling thread (progress, --viz).
   std::function<void(const FrameData&, const std::vector<Detection>&, const TrackResult&)> on_frame;
 };

@@ -1,11 +1,30 @@
 #include "ademono/slam/map.h"
 
+#include <algorithm>
+
 namespace ademono {
 
 std::shared_ptr<KeyFrame> Map::CreateKeyFrame(const Frame& frame) {
   auto kf = std::make_shared<KeyFrame>(next_keyframe_id_++, frame);
   keyframes_[kf->id] = kf;
+  if (database_ != nullptr) database_->Add(kf->id, kf->F().descriptors);
   return kf;
+}
+
+std::shared_ptr<KeyFrame> Map::RestoreKeyFrame(uint64_t id, const Frame& frame) {
+  auto kf = std::make_shared<KeyFrame>(id, frame);
+  keyframes_[id] = kf;
+  next_keyframe_id_ = std::max(next_keyframe_id_, id + 1);
+  if (database_ != nullptr) database_->Add(id, kf->F().descriptors);
+  return kf;
+}
+
+std::shared_ptr<MapPoint> Map::RestoreMapPoint(uint64_t id, const Eigen::Vector3d& position,
+                                               KeyFrame* reference, uint64_t frame_id) {
+  auto p = std::make_shared<MapPoint>(id, position, reference, frame_id);
+  points_[id] = p;
+  next_point_id_ = std::max(next_point_id_, id + 1);
+  return p;
 }
 
 std::shared_ptr<MapPoint> Map::CreateMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
@@ -103,6 +122,7 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
   }
   keyframe->children.clear();
   keyframe->bad = true;
+  if (database_ != nullptr) database_->Erase(keyframe->id);
   // Memory grows with the map, not with the frames: a culled keyframe keeps only its pose link
   // (the frames that referenced it still resolve through it), not its keypoints or descriptors.
   keyframe->features = WithoutKeypoints(keyframe->F());

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <vector>
 
+#include "ademono/place/keyframe_database.h"
 #include "ademono/slam/keyframe.h"
 #include "ademono/slam/map_point.h"
 
@@ -21,10 +22,24 @@ class Map {
  public:
   std::mutex mutex;
 
+  // Keyframes created and erased here are added to and erased from `database` (place
+  // recognition; not owned, may be null). Set before the first keyframe.
+  void SetKeyFrameDatabase(KeyFrameDatabase* database) { database_ = database; }
+  KeyFrameDatabase* GetKeyFrameDatabase() const { return database_; }
+
   std::shared_ptr<KeyFrame> CreateKeyFrame(const Frame& frame);
   std::shared_ptr<MapPoint> CreateMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
                                            uint64_t frame_id);
   void AddMapPoint(const std::shared_ptr<MapPoint>& point) { points_[point->id] = point; }
+  // Loading a saved map (map_io): a keyframe / point with its saved id, and the next ids.
+  std::shared_ptr<KeyFrame> RestoreKeyFrame(uint64_t id, const Frame& frame);
+  std::shared_ptr<MapPoint> RestoreMapPoint(uint64_t id, const Eigen::Vector3d& position,
+                                            KeyFrame* reference, uint64_t frame_id);
+  void SetNextIds(uint64_t next_keyframe_id, uint64_t next_point_id) {
+    next_keyframe_id_ = next_keyframe_id;
+    next_point_id_ = next_point_id;
+  }
+  uint64_t NextMapPointId() const { return next_point_id_; }
 
   // Marks the point bad, removes its observations and drops it from the map.
   void ErasePoint(MapPoint* point);
@@ -53,6 +68,7 @@ class Map {
   std::vector<std::shared_ptr<KeyFrame>> graveyard_;
   uint64_t next_keyframe_id_ = 0;
   uint64_t next_point_id_ = 0;
+  KeyFrameDatabase* database_ = nullptr;
 };
 
 }  // namespace ademono

@@ -125,7 +125,8 @@ const OptionsTable<SystemOptions>& SystemOptions::Table() {
                                 .AddSection("depth", &S::depth, FrameDepthOptions::Table())
                                 .AddSection("tracking", &S::tracking, TrackingOptions::Table())
                                 .AddSection("mapping", &S::mapping, MappingOptions::Table())
-                                .AddSection("optimizer", &S::pose, PoseOptimizerOptions::Table());
+                                .AddSection("optimizer", &S::pose, PoseOptimizerOptions::Table())
+                                .AddSection("place", &S::place, KeyFrameDatabaseOptions::Table());
   return table;
 }
 
@@ -136,6 +137,7 @@ void SystemOptions::Check() const {
   tracking.Check();
   mapping.Check();
   pose.Check();
+  place.Check();
 }
 
 SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesystem::path& path) {

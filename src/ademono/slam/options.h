@@ -18,6 +18,7 @@
 #include "ademono/filter/feature_filter.h"
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/pose_optimizer.h"
+#include "ademono/place/keyframe_database.h"
 
 namespace ademono {
 
@@ -130,6 +131,7 @@ struct SystemOptions {
   TrackingOptions tracking;
   MappingOptions mapping;
   PoseOptimizerOptions pose;  // the `optimizer:` node
+  KeyFrameDatabaseOptions place;  // place recognition index (relocalisation, loops)
   void Check() const;
   // Reads every sub-node of a config file's root. InputError "path: ..." on any problem, also for
   // an unknown key in `detector:` (DetectorOptions, read by the caller) and an unknown section.

@@ -3,15 +3,19 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <opencv2/imgproc.hpp>
 
+#include "ademono/core/error.h"
 #include "ademono/core/timing.h"
+#include "ademono/slam/map_io.h"
 
 namespace ademono {
 
 System::System(const Camera& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
+      keyframe_database_(options.place),
       extractor_(options.orb),
       pyramid_(std::make_shared<ScalePyramid>(
           ScalePyramid::Make(options.orb.num_levels, options.orb.scale_factor))),
@@ -20,6 +24,7 @@ System::System(const Camera& camera, const SystemOptions& options)
       tracking_(map_, local_mapping_, options) {
   camera_.Check();
   options_.Check();
+  map_.SetKeyFrameDatabase(&keyframe_database_);
 }
 
 System::~System() { Shutdown(); }
@@ -28,6 +33,49 @@ void System::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   local_mapping_.Shutdown();
+}
+
+namespace {
+
+bool SameCamera(const Camera& a, const Camera& b) {
+  auto close = [](double x, double y) { return std::abs(x - y) <= 1e-6 * std::max(1.0, std::abs(x)); };
+  if (a.width != b.width || a.height != b.height) return false;
+  if (!close(a.fx, b.fx) || !close(a.fy, b.fy) || !close(a.cx, b.cx) || !close(a.cy, b.cy))
+    return false;
+  for (size_t i = 0; i < a.distortion.size(); ++i)
+    if (!close(a.distortion[i], b.distortion[i])) return false;
+  return true;
+}
+
+std::string CameraText(const Camera& c) {
+  std::ostringstream o;
+  o << c.width << "x" << c.height << " fx " << c.fx << " fy " << c.fy << " cx " << c.cx << " cy "
+    << c.cy;
+  return o.str();
+}
+
+}  // namespace
+
+void System::LoadMap(const std::filesystem::path& path, bool localize_only) {
+  const MapFileData data = LoadMapFile(path);
+  if (!SameCamera(data.camera, camera_)) {
+    ThrowInputError(path, "the map's camera (" + CameraText(data.camera) +
+                              ") does not match the sequence's (" + CameraText(camera_) + ")");
+  }
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  if (map_.NumKeyFrames() != 0) throw std::logic_error("System::LoadMap: the map is not empty");
+  RestoreMap(data, pyramid_, map_);
+  tracking_.StartInLoadedMap(localize_only);
+}
+
+void System::SaveMap(const std::filesystem::path& path) {
+  Shutdown();
+  MapFileData data;
+  {
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    data = MapToRecords(map_, camera_, options_);
+  }
+  SaveMapFile(path, data);
 }
 
 std::vector<float> System::KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
@@ -190,6 +238,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
     // background the box covers).
     if (out.tracked && !depth.empty() && options_.filter.enable_dynamic_removal &&
+        !tracking_.LocalizeOnly() &&
         !moving_detections.empty())
       out.dynamic_points_culled +=
           CullPointsOnMovingObjects(out.cam_from_world, depth, moving_detections);

@@ -56,6 +56,13 @@ class System {
   // Finishes local mapping (threaded mode). Idempotent.
   void Shutdown();
 
+  // Map reuse (docs/maps.md). LoadMap: before the first frame; restores a saved map (InputError
+  // naming the file for a bad map or a camera that differs from this system's), then the first
+  // frames relocalise in it. With `localize_only` the map is never changed. SaveMap finishes
+  // local mapping (Shutdown) and writes the map atomically.
+  void LoadMap(const std::filesystem::path& path, bool localize_only);
+  void SaveMap(const std::filesystem::path& path);
+
   // Pose of every tracked input frame, resolved against the current keyframe poses.
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
@@ -73,6 +80,8 @@ class System {
   int NumTracked() const;
   const Camera& GetCamera() const { return camera_; }
   const SystemOptions& Options() const { return options_; }
+  // Place recognition index of the live keyframes (thread-safe on its own).
+  const KeyFrameDatabase& GetKeyFrameDatabase() const { return keyframe_database_; }
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
@@ -86,6 +95,9 @@ class System {
 
   Camera camera_;
   SystemOptions options_;
+  // Place recognition over the live keyframes (the map adds and erases them); declared before
+  // the map so it outlives the map's pointer to it.
+  KeyFrameDatabase keyframe_database_;
   OrbExtractor extractor_;
   std::shared_ptr<const ScalePyramid> pyramid_;
   FeatureFilter filter_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <opencv2/calib3d.hpp>
 
@@ -29,6 +30,20 @@ const char* TrackingStateName(TrackingState state) {
 
 Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
     : map_(map), local_mapping_(local_mapping), options_(options) {}
+
+void Tracking::StartInLoadedMap(bool localize_only) {
+  map_loaded_ = true;
+  localize_only_ = localize_only;
+  state_ = TrackingState::kLost;
+  // Frame ids continue after the loaded map's (recent-point and keyframe-spacing rules compare
+  // them).
+  uint64_t last = 0;
+  for (const auto& [id, kf] : map_.KeyFrames()) last = std::max(last, kf->frame_id);
+  for (const auto& [id, p] : map_.MapPoints()) last = std::max(last, p->first_frame_id);
+  next_frame_id_ = last + 1;
+  last_keyframe_frame_id_ = last;
+  last_reloc_frame_id_ = last;
+}
 
 std::optional<Rigid3d> Tracking::PredictNext() const {
   if (state_ != TrackingState::kOk || !last_frame_ || !last_frame_->cam_from_world || !velocity_) {
@@ -64,9 +79,22 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         if (p && p->bad) p.reset();
       }
     }
-    if (state_ == TrackingState::kOk) {
+    bool odometry_only = false, by_motion = false;
+    if (state_ == TrackingState::kOk && localize_only_ && visual_odometry_) {
+      // Off the map: odometry on the last frame's temporary points, unless relocalisation
+      // (tried on a copy) finds the map again.
+      Frame relocalised = frame;
+      if (Relocalise(relocalised)) {
+        frame = std::move(relocalised);
+        ok = out.relocalised = true;
+      } else if (velocity_) {
+        ok = by_motion = TrackWithMotionModel(frame);
+        odometry_only = ok && visual_odometry_;
+      }
+    } else if (state_ == TrackingState::kOk) {
       if (velocity_ && frame.id >= last_reloc_frame_id_ + 2) {
-        ok = TrackWithMotionModel(frame);
+        ok = by_motion = TrackWithMotionModel(frame);
+        odometry_only = ok && localize_only_ && visual_odometry_;
         if (!ok) ok = TrackReferenceKeyFrame(frame);
       } else {
         ok = TrackReferenceKeyFrame(frame);
@@ -76,7 +104,18 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       out.relocalised = ok;
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (ok) ok = TrackLocalMap(frame);
+    if (ok && !odometry_only) {
+      // Localisation only: leaving the map's coverage, keep the motion model's odometry pose.
+      std::optional<Frame> odometry;
+      if (localize_only_ && by_motion) odometry = frame;
+      ok = TrackLocalMap(frame);
+      if (ok) {
+        visual_odometry_ = false;
+      } else if (odometry) {
+        frame = std::move(*odometry);
+        ok = visual_odometry_ = true;
+      }
+    }
 
     if (ok) {
       if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
@@ -87,7 +126,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       state_ = TrackingState::kOk;
       lost_streak_ = 0;
       CorrectDepthScale(frame, true);
-      if (NeedNewKeyFrame(frame)) {
+      if (!localize_only_ && NeedNewKeyFrame(frame)) {
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame);
       }
@@ -95,13 +134,15 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
         if (frame.map_points[i] && frame.outlier[i]) frame.map_points[i].reset();
       }
+      if (localize_only_) AddVisualOdometryPoints(frame);
     } else {
       state_ = TrackingState::kLost;
       velocity_.reset();
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).
-      if (lost_streak_ > options_.tracking.reinit_after_lost_frames && last_good_pose_ &&
+      if (!localize_only_ && lost_streak_ > options_.tracking.reinit_after_lost_frames &&
+          last_good_pose_ &&
           CountDepthPoints(frame) >= options_.tracking.min_init_points) {
         frame.map_points.assign(frame.F().Size(), nullptr);
         ok = Initialise(frame, *last_good_pose_);
@@ -199,8 +240,9 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
 }
 
 void Tracking::AnchorScale(Frame& frame) {
+  // A loaded map's scale is the anchor (this session's network may read differently).
   if (!frame.F().DepthIsPrior() || !options_.depth.anchor_scale || log_scale_count_ == 0 ||
-      !local_mapping_.Idle()) {
+      !local_mapping_.Idle() || map_loaded_) {
     return;
   }
   // This frame counts too (it is added to the sum after tracking).
@@ -263,6 +305,20 @@ int Tracking::DiscardOutliers(Frame& frame) {
   return in_map;
 }
 
+void Tracking::AddVisualOdometryPoints(Frame& frame) {
+  const FrameFeatures& f = frame.F();
+  const Rigid3d world_from_cam = frame.cam_from_world->inverse();
+  for (size_t i = 0; i < f.Size(); ++i) {
+    if (frame.map_points[i] || !(f.depth[i] > 0)) continue;
+    // Not in the map (no id, no observation): lives only as long as the frames holding it.
+    auto point = std::make_shared<MapPoint>(UINT64_MAX, world_from_cam * f.UnprojectCamera(i),
+                                            nullptr, frame.id);
+    point->descriptor = f.descriptors.row(static_cast<int>(i)).clone();
+    frame.map_points[i] = std::move(point);
+    frame.outlier[i] = false;
+  }
+}
+
 bool Tracking::TrackWithMotionModel(Frame& frame) {
   const Matcher matcher(0.9f, true);
   frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
@@ -274,7 +330,15 @@ bool Tracking::TrackWithMotionModel(Frame& frame) {
   }
   if (matches < options_.tracking.min_motion_matches) return false;
   OptimizeFramePose(frame);
-  return DiscardOutliers(frame) >= 10;
+  const int in_map = DiscardOutliers(frame);
+  if (localize_only_) {
+    // ORB-SLAM2's localisation mode: few map points means odometry on the temporary ones.
+    int total = 0;
+    for (const auto& p : frame.map_points) total += p ? 1 : 0;
+    visual_odometry_ = in_map < 10;
+    return total >= 20;
+  }
+  return in_map >= 10;
 }
 
 bool Tracking::TrackReferenceKeyFrame(Frame& frame) {
@@ -347,7 +411,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
       p.reset();
       continue;
     }
-    ++p->visible;
+    if (!localize_only_) ++p->visible;
     p->last_frame_seen = frame.id;
   }
   std::vector<std::shared_ptr<MapPoint>> candidates;
@@ -357,7 +421,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     if (p->last_frame_seen == frame.id || p->bad) continue;
     ProjectionPrediction prediction;
     if (!frame.InFrustum(*p, 0.5f, &prediction)) continue;
-    ++p->visible;
+    if (!localize_only_) ++p->visible;
     candidates.push_back(p);
     predictions.push_back(prediction);
   }
@@ -372,7 +436,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p || frame.outlier[i]) continue;
-    ++p->found;
+    if (!localize_only_) ++p->found;
     if (p->NumObservations() > 0) ++matches_inliers_;
   }
   const uint64_t reloc_window =
@@ -457,10 +521,23 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
 }
 
 bool Tracking::Relocalise(Frame& frame) {
+  // Global candidates first (the place recognition index: anywhere in the map, e.g. a loaded
+  // one), then the most recent keyframes (where a short loss usually resumes).
   std::vector<KeyFrame*> candidates;
+  std::set<uint64_t> chosen;
+  const size_t per_source = static_cast<size_t>(options_.tracking.relocalisation_keyframes);
+  if (const KeyFrameDatabase* database = map_.GetKeyFrameDatabase(); database != nullptr) {
+    for (const PlaceCandidate& c : database->Query(frame.F().descriptors, per_source)) {
+      std::shared_ptr<KeyFrame> kf = map_.GetKeyFrame(c.keyframe_id);
+      if (kf && !kf->bad && chosen.insert(kf->id).second) candidates.push_back(kf.get());
+    }
+  }
+  size_t recent = 0;
   for (auto it = map_.KeyFrames().rbegin(); it != map_.KeyFrames().rend(); ++it) {
-    if (static_cast<int>(candidates.size()) >= options_.tracking.relocalisation_keyframes) break;
-    if (!it->second->bad) candidates.push_back(it->second.get());
+    if (recent >= per_source) break;
+    if (it->second->bad) continue;
+    ++recent;
+    if (chosen.insert(it->first).second) candidates.push_back(it->second.get());
   }
   const FrameFeatures& f = frame.F();
   const Matcher matcher(0.75f, true);

@@ -3,7 +3,8 @@
 // initialisation): map initialisation from the first frame with enough depth, constant-velocity
 // tracking by projection (window widened once), reference-keyframe tracking by descriptor
 // matching as fallback, local-map tracking, the keyframe decision, relocalisation (PnP RANSAC
-// against recent keyframes) and a restart from the last pose after a long loss.
+// against the keyframe database's candidates, then recent keyframes) and a restart from the last
+// pose after a long loss.
 // Every call runs with the map mutex held by the caller.
 
 #include <cstdint>
@@ -59,6 +60,12 @@ class Tracking {
   const std::optional<Frame>& LastFrame() const { return last_frame_; }
   int NumLost() const { return num_lost_; }
   int NumRelocalisations() const { return num_relocalisations_; }
+  // After a saved map was restored into the (otherwise empty) map: the first frames relocalise
+  // in it (global relocalisation through the keyframe database) instead of initialising a new
+  // map, and the loaded map keeps its scale (no anchoring to this session's network). With
+  // `localize_only` the map never changes: no keyframe, no point, no point statistics.
+  void StartInLoadedMap(bool localize_only);
+  bool LocalizeOnly() const { return localize_only_; }
 
  private:
   bool Initialise(Frame& frame, const Rigid3d& cam_from_world);
@@ -101,6 +108,15 @@ class Tracking {
   double last_depth_scale_ = 1.0;  // the last tracked frame's network scale correction
   double log_scale_sum_ = 0.0;     // sum of log(depth_scale) over tracked frames
   int log_scale_count_ = 0;
+  bool map_loaded_ = false;
+  bool localize_only_ = false;
+  // Localisation-only mode (ORB-SLAM2's mbVO): the last frame tracked mostly on temporary
+  // visual-odometry points (its own depth readings, never added to the map) because the map was
+  // out of view; each such frame also tries relocalisation to get back onto the map.
+  bool visual_odometry_ = false;
+  // Localisation-only mode: temporary points from the frame's own depth for the keypoints that
+  // matched no map point, so the next frame can track by odometry where the map does not reach.
+  void AddVisualOdometryPoints(Frame& frame);
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
   std::vector<FrameRecord> records_;
