@@ -80,7 +80,73 @@ struct Sim3EdgeCost {
   Eigen::Vector3d inv_translation;
 };
 
+// Reprojection of a source point into the target (forward: x_b = s R x_a + t) or, inverted, of a
+// target point into the source (x_a = R^T (x_b - t) / s).
+struct Sim3ReprojectionCost {
+  Sim3ReprojectionCost(const Sim3Observation& o, const PinholeIntrinsics& in, bool inverse)
+      : obs(o), intrinsics(in), inverse(inverse) {}
+  template <typename T>
+  bool operator()(const T* q, const T* t, const T* log_s, T* residual) const {
+    using Vec3 = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Eigen::Quaternion<T>> R(q);
+    const Eigen::Map<const Vec3> tr(t);
+    const T s = ceres::exp(log_s[0]);
+    const Vec3 x = obs.point.cast<T>();
+    const Vec3 y = inverse ? Vec3((R.conjugate() * (x - tr)) / s) : Vec3(s * (R * x) + tr);
+    if (y.z() <= T(1e-6)) {
+      residual[0] = residual[1] = T(0);
+      return true;
+    }
+    const T w = T(std::sqrt(obs.inv_sigma2));
+    residual[0] = w * (T(intrinsics.fx) * y.x() / y.z() + T(intrinsics.cx) - T(obs.pixel.x()));
+    residual[1] = w * (T(intrinsics.fy) * y.y() / y.z() + T(intrinsics.cy) - T(obs.pixel.y()));
+    return true;
+  }
+  Sim3Observation obs;
+  PinholeIntrinsics intrinsics;
+  bool inverse;
+};
+
 }  // namespace
+
+Sim3d RefineSim3(const Sim3d& b_from_a, const PinholeIntrinsics& intrinsics_a,
+                 const PinholeIntrinsics& intrinsics_b, const std::vector<Sim3Observation>& in_b,
+                 const std::vector<Sim3Observation>& in_a, bool fix_scale, int iterations) {
+  Eigen::Vector4d q = b_from_a.rotation.normalized().coeffs();
+  Eigen::Vector3d t = b_from_a.translation;
+  double log_s = std::log(b_from_a.scale);
+  ceres::Problem problem;
+  problem.AddParameterBlock(q.data(), 4, new ceres::EigenQuaternionManifold());
+  problem.AddParameterBlock(t.data(), 3);
+  problem.AddParameterBlock(&log_s, 1);
+  for (const Sim3Observation& o : in_b) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Sim3ReprojectionCost, 2, 4, 3, 1>(
+            new Sim3ReprojectionCost(o, intrinsics_b, false)),
+        new ceres::HuberLoss(std::sqrt(5.991)), q.data(), t.data(), &log_s);
+  }
+  for (const Sim3Observation& o : in_a) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Sim3ReprojectionCost, 2, 4, 3, 1>(
+            new Sim3ReprojectionCost(o, intrinsics_a, true)),
+        new ceres::HuberLoss(std::sqrt(5.991)), q.data(), t.data(), &log_s);
+  }
+  if (fix_scale) problem.SetParameterBlockConstant(&log_s);
+  if (problem.NumResidualBlocks() > 0) {
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = iterations;
+    options.num_threads = 1;
+    options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+  }
+  Sim3d out;
+  out.rotation = Eigen::Quaterniond(q.data()).normalized();
+  out.translation = t;
+  out.scale = std::exp(log_s);
+  return out;
+}
 
 PoseGraphResult SolvePoseGraph(const PoseGraphProblem& problem) {
   const size_t n = problem.cam_from_world.size();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ademono/core/geometry.h"
+#include "ademono/optimize/optimizer_types.h"
 
 namespace ademono {
 
@@ -50,5 +51,19 @@ struct PoseGraphResult {
 
 // Throws std::invalid_argument for bad indices or sizes.
 PoseGraphResult SolvePoseGraph(const PoseGraphProblem& problem);
+
+// A point of one camera observed by a keypoint of the other (ORB-SLAM's OptimizeSim3 edges).
+struct Sim3Observation {
+  Eigen::Vector3d point;  // in the source camera's frame
+  Eigen::Vector2d pixel;  // undistorted keypoint in the target camera
+  double inv_sigma2 = 1;  // 1 / sigma^2 of the keypoint's level
+};
+
+// Refines b_from_a (a Sim(3), or SE(3) with fix_scale) by reprojection: `in_b` are points of a
+// seen in b's image, `in_a` points of b seen in a's image. Huber loss (chi2 5.99 at one sigma of
+// the level); returns the refined transform.
+Sim3d RefineSim3(const Sim3d& b_from_a, const PinholeIntrinsics& intrinsics_a,
+                 const PinholeIntrinsics& intrinsics_b, const std::vector<Sim3Observation>& in_b,
+                 const std::vector<Sim3Observation>& in_a, bool fix_scale, int iterations = 10);
 
 }  // namespace ademono

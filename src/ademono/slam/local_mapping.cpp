@@ -102,6 +102,7 @@ void LocalMapping::Process(const std::shared_ptr<KeyFrame>& keyframe) {
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
     CullKeyFrames(*keyframe);
+    if (loop_closing_ != nullptr && !keyframe->bad) loop_closing_->Process(*keyframe);
   }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
 
@@ -27,6 +28,10 @@ class LocalMapping {
   ~LocalMapping();
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
+
+  // Loop closing runs on each keyframe right after its local mapping step (same thread, same
+  // point in the sequence in deterministic mode). Null disables it. Set before the first keyframe.
+  void SetLoopClosing(LoopClosing* loop_closing) { loop_closing_ = loop_closing; }
 
   // The caller must not hold map.mutex.
   void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe);
@@ -53,6 +58,7 @@ class LocalMapping {
   Map& map_;
   MappingOptions options_;
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
+  LoopClosing* loop_closing_ = nullptr;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;

@@ -25,6 +25,17 @@ System::System(const Camera& camera, const SystemOptions& options)
   camera_.Check();
   options_.Check();
   map_.SetKeyFrameDatabase(&keyframe_database_);
+  if (options_.loop.enabled) {
+    loop_closing_ = std::make_unique<LoopClosing>(
+        map_, keyframe_database_, options_.loop, options_.loop.UseSim3(options_.depth.IsPrior()),
+        options_.mapping.fuse_radius);
+    local_mapping_.SetLoopClosing(loop_closing_.get());
+  }
+}
+
+std::vector<LoopEvent> System::Loops() const {
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  return loop_closing_ ? loop_closing_->Events() : std::vector<LoopEvent>{};
 }
 
 System::~System() { Shutdown(); }
@@ -268,6 +279,11 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   if (out.new_keyframe) {
     result.new_keyframe = true;
     local_mapping_.InsertKeyFrame(out.new_keyframe);
+    // Deterministic mode: a loop closed on this keyframe moved the world under this frame.
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    tracking_.FollowLoopCorrection();
+    const auto& last = tracking_.LastFrame();
+    if (out.tracked && last && last->cam_from_world) out.cam_from_world = *last->cam_from_world;
   }
   // Deterministic mode has waited for this keyframe; threaded mode reports what finished meanwhile.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();

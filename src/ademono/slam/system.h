@@ -16,6 +16,7 @@
 #include "ademono/io/trajectory.h"
 #include "ademono/perception/detection.h"
 #include "ademono/slam/local_mapping.h"
+#include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
 #include "ademono/slam/tracking.h"
@@ -82,6 +83,8 @@ class System {
   const SystemOptions& Options() const { return options_; }
   // Place recognition index of the live keyframes (thread-safe on its own).
   const KeyFrameDatabase& GetKeyFrameDatabase() const { return keyframe_database_; }
+  // Loops closed so far (loop closing, docs/loops.md).
+  std::vector<LoopEvent> Loops() const;
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,
@@ -103,6 +106,7 @@ class System {
   FeatureFilter filter_;
   mutable Map map_;  // mutable: const accessors lock its mutex
   LocalMapping local_mapping_;
+  std::unique_ptr<LoopClosing> loop_closing_;  // null when loop.enabled is false
   Tracking tracking_;
   std::optional<PreviousFrameFeatures> previous_;
   // Colour of each map point's first observation (for map.ply), keyed by point id.
