@@ -61,7 +61,7 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       auto args = std::make_shared<SynthArgs>();
       app.add_option("--scene", args->scene, "office | street")->capture_default_str();
       app.add_option("--motion", args->motion,
-                     "xyz | halfsphere | rpy | static | forward (default: xyz for office, "
+                     "xyz | halfsphere | rpy | static | forward | loop (default: xyz for office, "
                      "forward for street)");
       app.add_option("--frames", args->frames, "number of frames")->capture_default_str();
       app.add_option("--seed", args->seed, "random seed (textures, actors, jitter)")

@@ -86,7 +86,7 @@ TEST_F(SynthCliTest, BadOptionsFailWithOneLineAndNoOutput) {
             "(expected office or street)\n"},
            {"--motion spin",
             "ademono synth: error: unknown motion 'spin' (expected xyz, "
-            "halfsphere, rpy, static or forward)\n"},
+            "halfsphere, rpy, static, forward or loop)\n"},
            {"--frames 0", "ademono synth: error: invalid options: frames must be in [1, 100000]\n"},
            {"--width 8",
             "ademono synth: error: invalid options: width and height must be in "

@@ -135,7 +135,11 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
                                    "detector",  "seed",          "deterministic", "filters",
                                    "frames",    "tracked",       "untracked",     "lost",
                                    "keyframes", "map_points",    "wall_seconds",  "fps",
-                                   "timing",    "filter_counts", "accuracy",      "per_frame"}));
+                                   "timing",    "filter_counts", "accuracy",      "per_frame",
+                                   "loops"}));
+  // A short xyz sequence revisits no place away from the live map: no loop.
+  EXPECT_TRUE(s["loops"].is_array());
+  EXPECT_TRUE(s["loops"].empty());
   EXPECT_EQ(Keys(s["filters"]),
             (std::set<std::string>{"enhancement", "dynamic_removal", "distant"}));
   EXPECT_EQ(Keys(s["timing"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",

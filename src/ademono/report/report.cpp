@@ -260,6 +260,22 @@ json FramesJson(const RunFolder& run, double t0) {
   }
   cols["filter"] = std::move(filter);
   cols["ms"] = std::move(ms);
+  // Frames that closed a loop (summary.json `loops`, absent in older runs): 1, else 0.
+  json loop = json::array();
+  for (size_t k = 0; k < per_frame.size(); ++k) loop.push_back(0);
+  if (run.summary.contains("loops")) {
+    try {
+      for (const json& l : run.summary.at("loops")) {
+        const int query = l.at("query_frame").get<int>();
+        for (size_t k = 0; k < per_frame.size(); ++k) {
+          if (cols["frame"][k].get<int>() == query) loop[k] = 1;
+        }
+      }
+    } catch (const json::exception& e) {
+      ThrowInputError(file, std::string("loops: ") + e.what());
+    }
+  }
+  cols["loop"] = std::move(loop);
   if (any_scale) cols["depth_scale"] = std::move(depth_scale);
   return cols;
 }

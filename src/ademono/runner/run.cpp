@@ -184,6 +184,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     }
   }
   report.map_cloud = system.MapPointCloud();
+  report.loops = system.Loops();
   report.timing = {{"extraction", Timing(report.per_frame, &FrameTiming::extraction_ms)},
                    {"depth", Timing(report.per_frame, &FrameTiming::depth_ms)},
                    {"detection", Timing(report.per_frame, &FrameTiming::detection_ms)},
@@ -262,6 +263,25 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     if (f.depth_scale) per_frame.back()["depth_scale"] = *f.depth_scale;
   }
   j["per_frame"] = std::move(per_frame);
+  nlohmann::json loops = nlohmann::json::array();
+  for (const LoopEvent& e : report.loops) {
+    loops.push_back({{"query_keyframe", e.query_keyframe},
+                     {"match_keyframe", e.match_keyframe},
+                     {"query_frame", e.query_frame},
+                     {"match_frame", e.match_frame},
+                     {"timestamp", e.query_timestamp},
+                     {"transform", e.sim3 ? "sim3" : "se3"},
+                     {"scale", e.scale},
+                     {"inliers", e.inliers},
+                     {"matches", e.matches},
+                     {"fused_points", e.fused_points},
+                     {"correction_m", e.correction_m},
+                     {"correction_deg", e.correction_deg},
+                     {"graph_keyframes", e.graph_keyframes},
+                     {"graph_edges", e.graph_edges},
+                     {"ms", e.milliseconds}});
+  }
+  j["loops"] = std::move(loops);
   return j;
 }
 

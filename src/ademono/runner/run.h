@@ -111,6 +111,7 @@ struct RunReport {
   // without ground truth).
   Trajectory ground_truth;
   std::vector<System::ColoredPoint> map_cloud;
+  std::vector<LoopEvent> loops;  // closed loops, in order
 
   size_t Tracked() const { return trajectory.size(); }
   double Fps() const { return wall_seconds > 0 ? static_cast<double>(frames) / wall_seconds : 0.0; }

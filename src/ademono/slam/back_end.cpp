@@ -18,6 +18,17 @@ BackEnd::BackEnd(const Camera& camera, const SystemOptions& options)
       local_mapping_(map_, options.mapping),
       tracking_(map_, local_mapping_, options) {
   map_.SetKeyFrameDatabase(&keyframe_database_);
+  if (options_.loop.enabled) {
+    loop_closing_ = std::make_unique<LoopClosing>(
+        map_, keyframe_database_, options_.loop, options_.loop.UseSim3(options_.depth.IsPrior()),
+        options_.mapping.fuse_radius);
+    local_mapping_.SetLoopClosing(loop_closing_.get());
+  }
+}
+
+std::vector<LoopEvent> BackEnd::Loops() const {
+  std::lock_guard<std::mutex> lock(map_.mutex);
+  return loop_closing_ ? loop_closing_->Events() : std::vector<LoopEvent>{};
 }
 
 BackEnd::~BackEnd() { Shutdown(); }
@@ -141,6 +152,11 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   if (out.new_keyframe) {
     result.new_keyframe = true;
     local_mapping_.InsertKeyFrame(out.new_keyframe, frame.index);
+    // Inserting merges the previous keyframe: a loop closed there moved the world under this frame.
+    std::lock_guard<std::mutex> lock(map_.mutex);
+    tracking_.FollowLoopCorrection();
+    const auto& last = tracking_.LastFrame();
+    if (out.tracked && last && last->cam_from_world) out.cam_from_world = *last->cam_from_world;
   }
   // The keyframes merged by this frame (at their hand-off), each once.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();

@@ -16,6 +16,7 @@
 #include "ademono/place/keyframe_database.h"
 #include "ademono/slam/front_end.h"
 #include "ademono/slam/local_mapping.h"
+#include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
 #include "ademono/slam/tracking.h"
@@ -62,6 +63,8 @@ class BackEnd {
   void SaveMap(const std::filesystem::path& path);
   // Place recognition index of the live keyframes (thread-safe on its own).
   const KeyFrameDatabase& GetKeyFrameDatabase() const { return keyframe_database_; }
+  // Loops closed so far (loop closing, docs/loops.md).
+  std::vector<LoopEvent> Loops() const;
 
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
@@ -84,6 +87,8 @@ class BackEnd {
   // the map so it outlives the map's pointer to it.
   KeyFrameDatabase keyframe_database_;
   mutable Map map_;  // mutable: const accessors lock its mutex
+  // Null when loop.enabled is false; declared before local mapping, which calls it until shutdown.
+  std::unique_ptr<LoopClosing> loop_closing_;
   LocalMapping local_mapping_;
   Tracking tracking_;
   // Colour of each map point's first observation (for map.ply), keyed by point id.

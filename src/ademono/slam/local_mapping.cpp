@@ -99,6 +99,7 @@ void LocalMapping::Merge() {
     std::lock_guard<std::mutex> lock(map_.mutex);
     if (pending->has_ba) ApplyBundleAdjustment(*pending);
     CullKeyFrames(*pending->keyframe);
+    if (loop_closing_ != nullptr && !pending->keyframe->bad) loop_closing_->Process(*pending->keyframe);
   }
   finished_ms_ += pending->ms + MsSinceStart(start);
 }

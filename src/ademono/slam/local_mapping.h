@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ademono/optimize/bundle_adjustment.h"
+#include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
 #include "ademono/slam/options.h"
 
@@ -35,6 +36,11 @@ class LocalMapping {
   ~LocalMapping();
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
+
+  // Loop closing runs on each keyframe right after its merge (on the tracking thread, at the
+  // keyframe's hand-off frame: a fixed point in the sequence). Null disables it. Set before the
+  // first keyframe.
+  void SetLoopClosing(LoopClosing* loop_closing) { loop_closing_ = loop_closing; }
 
   // Tracking thread, map.mutex not held. Merges the pending keyframe's BA when `frame_index` has
   // reached its hand-off frame (waits for the mapping thread if it is not done).
@@ -84,6 +90,7 @@ class LocalMapping {
   Map& map_;
   MappingOptions options_;
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
+  LoopClosing* loop_closing_ = nullptr;
   std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below
 
   std::mutex job_mutex_;

@@ -59,6 +59,10 @@ class Map {
   size_t NumKeyFrames() const { return keyframes_.size(); }
   size_t NumMapPoints() const { return points_.size(); }
   uint64_t NextKeyFrameId() const { return next_keyframe_id_; }
+  // Loop closing moved keyframes and points: the tracker re-derives its last pose when this
+  // count changes.
+  void NoteLoopCorrection() { ++loop_corrections_; }
+  uint64_t LoopCorrections() const { return loop_corrections_; }
   // Pose of a (possibly culled) keyframe resolved through the spanning tree: cam_from_world.
   static Rigid3d ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe);
 
@@ -69,6 +73,7 @@ class Map {
   uint64_t next_keyframe_id_ = 0;
   uint64_t next_point_id_ = 0;
   KeyFrameDatabase* database_ = nullptr;
+  uint64_t loop_corrections_ = 0;
 };
 
 }  // namespace ademono

@@ -116,6 +116,34 @@ MappingOptions MappingOptions::FromYaml(const YAML::Node& node) {
 
 YAML::Node MappingOptions::ToYaml() const { return Table().Write(*this); }
 
+const OptionsTable<LoopOptions>& LoopOptions::Table() {
+  using L = LoopOptions;
+  static const auto table =
+      OptionsTable<L>("loop")
+          .Add("enabled", &L::enabled)
+          .Add("min_keyframes", &L::min_keyframes, Range::AtLeast(2))
+          .Add("recent_keyframes", &L::recent_keyframes, Range::AtLeast(1))
+          .Add("max_candidates", &L::max_candidates, Range::AtLeast(1))
+          .Add("min_matches", &L::min_matches, Range::AtLeast(3))
+          .Add("ransac_iterations", &L::ransac_iterations, Range::AtLeast(1))
+          .Add("min_inliers", &L::min_inliers, Range::AtLeast(3))
+          .Add("min_projection_matches", &L::min_projection_matches, Range::AtLeast(3))
+          .Add("search_radius", &L::search_radius, Range::Above(0))
+          .Add("consistency", &L::consistency, Range::AtLeast(1))
+          .Add("strong_edge_weight", &L::strong_edge_weight, Range::AtLeast(1))
+          .Add("pose_graph_iterations", &L::pose_graph_iterations, Range::AtLeast(1))
+          .Add("transform", &L::transform);
+  return table;
+}
+
+void LoopOptions::Check() const {
+  Table().CheckRanges(*this);
+  Require(transform == "auto" || transform == "sim3" || transform == "se3",
+          "loop: transform must be auto, sim3 or se3");
+  Require(min_projection_matches >= min_inliers,
+          "loop: need min_projection_matches >= min_inliers");
+}
+
 const OptionsTable<SystemOptions>& SystemOptions::Table() {
   using S = SystemOptions;
   static const auto table = OptionsTable<S>("(root)")
@@ -127,7 +155,8 @@ const OptionsTable<SystemOptions>& SystemOptions::Table() {
                                 .AddSection("tracking", &S::tracking, TrackingOptions::Table())
                                 .AddSection("mapping", &S::mapping, MappingOptions::Table())
                                 .AddSection("optimizer", &S::pose, PoseOptimizerOptions::Table())
-                                .AddSection("place", &S::place, KeyFrameDatabaseOptions::Table());
+                                .AddSection("place", &S::place, KeyFrameDatabaseOptions::Table())
+                                .AddSection("loop", &S::loop, LoopOptions::Table());
   return table;
 }
 
@@ -139,6 +168,7 @@ void SystemOptions::Check() const {
   mapping.Check();
   pose.Check();
   place.Check();
+  loop.Check();
 }
 
 SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesystem::path& path) {

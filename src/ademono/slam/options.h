@@ -128,6 +128,32 @@ struct MappingOptions {
   bool operator==(const MappingOptions&) const = default;
 };
 
+// Loop closing (`loop:` node, docs/loops.md): place recognition on each new keyframe, geometric
+// verification, then a pose-graph correction over the essential graph and point fusion.
+struct LoopOptions {
+  bool enabled = true;
+  int min_keyframes = 12;        // map size before any loop is searched
+  int recent_keyframes = 20;     // the query keyframe's last this-many keyframe ids are excluded
+  int max_candidates = 3;        // place-recognition candidates verified per keyframe
+  int min_matches = 25;          // descriptor matches (ratio test) with a candidate
+  int ransac_iterations = 300;   // 3-point Umeyama hypotheses
+  int min_inliers = 20;          // of the 3D-3D RANSAC (reprojection chi2 in both views)
+  int min_projection_matches = 40;  // after the guided projection search (RANSAC inliers included)
+  double search_radius = 10;     // px at level 0 for the projection search
+  int consistency = 3;           // consecutive keyframes verified against the same place
+  int strong_edge_weight = 100;  // covisibility edges kept in the essential graph
+  int pose_graph_iterations = 20;
+  // "auto": Sim(3) when depth is a network's prior (its scale drifts), SE(3) with sensor depth;
+  // "sim3" | "se3" force one.
+  std::string transform = "auto";
+  bool UseSim3(bool depth_is_prior) const {
+    return transform == "sim3" || (transform == "auto" && depth_is_prior);
+  }
+  void Check() const;
+  static const OptionsTable<LoopOptions>& Table();
+  bool operator==(const LoopOptions&) const = default;
+};
+
 struct SystemOptions {
   OrbOptions orb;
   FilterOptions filter;
@@ -136,6 +162,7 @@ struct SystemOptions {
   MappingOptions mapping;
   PoseOptimizerOptions pose;  // the `optimizer:` node
   KeyFrameDatabaseOptions place;  // place recognition index (relocalisation, loops)
+  LoopOptions loop;
   void Check() const;
   // Reads every sub-node of a config file's root. InputError "path: ..." on any problem, also for
   // an unknown key in `detector:` (DetectorOptions, read by the caller) and an unknown section.

@@ -77,6 +77,8 @@ class System {
   const SystemOptions& Options() const { return options_; }
   // Place recognition index of the live keyframes (thread-safe on its own).
   const KeyFrameDatabase& GetKeyFrameDatabase() const { return back_end_.GetKeyFrameDatabase(); }
+  // Loops closed so far (loop closing, docs/loops.md).
+  std::vector<LoopEvent> Loops() const { return back_end_.Loops(); }
 
   // Per-keypoint depth from the depth map: nearest pixel, range and discontinuity checks.
   static std::vector<float> KeypointDepths(const std::vector<cv::KeyPoint>& keypoints,

@@ -58,8 +58,20 @@ int Tracking::CountDepthPoints(const Frame& frame) const {
   return n;
 }
 
+void Tracking::FollowLoopCorrection() {
+  if (map_.LoopCorrections() == loop_corrections_seen_) return;
+  loop_corrections_seen_ = map_.LoopCorrections();
+  if (records_.empty() || !records_.back().tracked || records_.back().reference == nullptr) return;
+  // The velocity is relative and stays; absolute poses follow the reference keyframe.
+  const Rigid3d corrected =
+      Map::ResolvePose(records_.back().reference, records_.back().cam_from_reference);
+  if (last_frame_ && last_frame_->cam_from_world) last_frame_->cam_from_world = corrected;
+  if (last_good_pose_) last_good_pose_ = corrected;
+}
+
 TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
                                double timestamp) {
+  FollowLoopCorrection();
   // Network depth starts from the last frame's correction (its scale wanders slowly).
   if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
     features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));

@@ -53,6 +53,11 @@ class Tracking {
   TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
                        double timestamp);
 
+  // After a loop correction moved the keyframes (Map::LoopCorrections changed): the last frame's
+  // pose is re-derived from its reference keyframe. Called at every Track() and by System right
+  // after a keyframe was mapped; a no-op otherwise.
+  void FollowLoopCorrection();
+
   TrackingState State() const { return state_; }
   const std::vector<FrameRecord>& Records() const { return records_; }
   // Constant-velocity prediction of the next frame's pose (if tracking is OK).
@@ -95,6 +100,7 @@ class Tracking {
   SystemOptions options_;
   TrackingState state_ = TrackingState::kNotInitialized;
   uint64_t next_frame_id_ = 0;
+  uint64_t loop_corrections_seen_ = 0;
   std::optional<Frame> last_frame_;
   std::optional<Rigid3d> velocity_;        // current_from_last
   std::optional<Rigid3d> last_good_pose_;  // cam_from_world of the last tracked frame

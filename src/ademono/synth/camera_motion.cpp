@@ -40,8 +40,9 @@ MotionKind ParseMotionKind(const std::string& name) {
   if (name == "rpy") return MotionKind::kRpy;
   if (name == "static") return MotionKind::kStatic;
   if (name == "forward") return MotionKind::kForward;
+  if (name == "loop") return MotionKind::kLoop;
   throw std::invalid_argument("unknown motion '" + name +
-                              "' (expected xyz, halfsphere, rpy, static or forward)");
+                              "' (expected xyz, halfsphere, rpy, static, forward or loop)");
 }
 
 std::string MotionKindName(MotionKind kind) {
@@ -56,6 +57,8 @@ std::string MotionKindName(MotionKind kind) {
       return "static";
     case MotionKind::kForward:
       return "forward";
+    case MotionKind::kLoop:
+      return "loop";
   }
   return "?";
 }
@@ -116,6 +119,19 @@ std::function<Rigid3d(double)> MakeCameraTrajectory(const MotionSpec& spec) {
       case MotionKind::kForward:
         world_from_cam.translation() += base_rotation.col(2) * (spec.forward_speed * t);
         break;
+      case MotionKind::kLoop: {
+        const double angle = spec.loop_start_rad + kTwoPi * t / spec.loop_period_s;
+        const Eigen::Vector3d radial(std::cos(angle), std::sin(angle), 0.0);
+        const Eigen::Vector3d position =
+            spec.loop_centre + Eigen::Vector3d(spec.loop_radii.x() * radial.x(),
+                                               spec.loop_radii.y() * radial.y(), 0.0);
+        const Eigen::Vector3d tangent(-spec.loop_radii.x() * std::sin(angle),
+                                      spec.loop_radii.y() * std::cos(angle), 0.0);
+        const Eigen::Vector3d ahead = spec.loop_look_ahead ? tangent.normalized() : radial;
+        const Eigen::Vector3d view = ahead - std::tan(spec.loop_pitch_rad) * spec.world_up;
+        world_from_cam = LookAt(position, position + view, spec.world_up);
+        break;
+      }
     }
     const Eigen::Vector3d shake_translation(jitter[0](t), jitter[1](t), jitter[2](t));
     const Eigen::Vector3d shake_rotation(jitter[3](t), jitter[4](t), jitter[5](t));

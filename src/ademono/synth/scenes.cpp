@@ -71,6 +71,11 @@ Camera ScaledCamera(const Camera& base, int width, int height) {
   return camera;
 }
 
+// One lap of the loop motion takes 85 % of the sequence.
+double LoopPeriod(const SceneOptions& options, double fps) {
+  return 0.85 * static_cast<double>(options.frames) / fps;
+}
+
 void BuildOffice(const SceneOptions& options, Scene& scene) {
   Rng rng(SubSeed(options.seed, 0x0FF1CE));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E87));
@@ -120,12 +125,16 @@ void BuildOffice(const SceneOptions& options, Scene& scene) {
     scene.static_boxes.reserve(scene.static_boxes.size() + 6);
     AppendPerson(At(1.5, 1.7, 0, -M_PI / 2), 0.3, look, id, scene.static_boxes);
   }
-  // Walking persons across the view at different distances from the camera (y = -1.6).
+  // Walking persons across the view at different distances from the camera (y = -1.6). The loop
+  // motion circles the middle of the room, so there they walk along the near wall instead.
+  const bool loop = options.motion == MotionKind::kLoop;
   const double lanes[3] = {0.25, -0.45, 0.85};
+  const double loop_lanes[3] = {-1.95, -2.1, -1.8};
   for (int i = 0; i < options.persons; ++i) {
+    const double lane = loop ? loop_lanes[i] : lanes[i];
     BackAndForthPath path;
-    path.a = {-2.5, lanes[i], 0};
-    path.b = {2.5, lanes[i] + rng.Uniform(-0.2, 0.2), 0};
+    path.a = {-2.5, lane, 0};
+    path.b = {2.5, lane + rng.Uniform(-0.2, 0.2) * (loop ? 0.5 : 1.0), 0};
     path.speed = rng.Uniform(0.9, 1.3);
     path.offset_m = rng.Uniform(0, 10.0);
     const PersonLook look = MakePersonLook(textures, rng, rng.Uniform(0.93, 1.05));
@@ -139,6 +148,13 @@ void BuildOffice(const SceneOptions& options, Scene& scene) {
   motion.base_world_from_cam = LookAt(start, {0, 1.5, 0.95}, {0, 0, 1});
   motion.look_at = {0, 1.4, 0.9};
   motion.forward_speed = 0.15;
+  // loop: an ellipse 3 x 2 m around the room's middle, looking at the walls 1.3-1.7 m away;
+  // one lap takes 85 % of the sequence, so its last 15 % revisit the first views (the desk).
+  motion.loop_centre = {0, -0.2, 1.45};
+  motion.loop_radii = {1.5, 1.0};
+  motion.loop_period_s = LoopPeriod(options, scene.fps);
+  motion.loop_start_rad = M_PI / 2;
+  motion.loop_pitch_rad = 0.15;
   motion.seed = SubSeed(options.seed, 0xCA3);
   scene.world_from_cam = MakeCameraTrajectory(motion);
 }
@@ -271,6 +287,100 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
   scene.world_from_cam = MakeCameraTrajectory(motion);
 }
 
+// The street's loop: a ring road (the camera in the outer lane, counter-clockwise at about
+// 10 m/s, one lap in 85 % of the sequence) lined with facades on both sides and parked cars; no
+// moving objects. Same camera as the street.
+void BuildStreetLoop(const SceneOptions& options, Scene& scene) {
+  Rng rng(SubSeed(options.seed, 0x100B));
+  TextureMaker textures(scene, SubSeed(options.seed, 0x7E89));
+  scene.fps = 10.0;
+  Camera camera;
+  camera.width = 1241, camera.height = 376;
+  camera.fx = camera.fy = 718.856;
+  camera.cx = 607.1928, camera.cy = 185.2157;
+  scene.camera = ScaledCamera(camera, options.width, options.height);
+  scene.sky_bgr = {235.f, 205.f, 170.f};
+
+  const double period = LoopPeriod(options, scene.fps);
+  const double camera_radius = std::max(25.0, 10.0 * period / (2 * M_PI));
+  const double axis = camera_radius - 1.75;  // road centre line; the camera in the outer lane
+  // A pose on the ring at `angle`, `offset` metres outwards from the road axis, box x along the
+  // road.
+  auto on_ring = [&](double angle, double offset, double z) {
+    const double r = axis + offset;
+    return At(r * std::cos(angle), r * std::sin(angle), z, angle + M_PI / 2);
+  };
+  const double ground = axis + 70.0;
+  scene.static_boxes.push_back(MakeBox(
+      At(0, 0, -0.11), {ground, ground, 0.05},
+      textures.Make(TextureStyle::kFloor, 2 * ground, 2 * ground, 0.2, {0.45f, 0.8f, 0.55f})));
+  const int segments = static_cast<int>(std::ceil(2 * M_PI * axis / 10.0));
+  const double step = 2 * M_PI / segments;
+  for (int k = 0; k < segments; ++k) {
+    const double angle = k * step;
+    // Slightly longer than the chord at the outer edge so the polygon has no gaps.
+    const double length = 2 * (axis + 11.0) * std::sin(step / 2) + 0.2;
+    scene.static_boxes.push_back(MakeBox(on_ring(angle, 0, -0.05), {length / 2, 7.0, 0.05},
+                                         textures.Make(TextureStyle::kRoad, length, 14.0, 0.02)));
+    for (int side : {-1, 1}) {
+      scene.static_boxes.push_back(MakeBox(
+          on_ring(angle, 9.0 * side, 0.075), {length / 2, 2.0, 0.075},
+          textures.Make(TextureStyle::kSidewalk, length, 4.0, 0.02, {0.85f, 0.9f, 0.95f})));
+    }
+  }
+  // Facades along both sides, 11-15 m from the road axis (inside only where the ring leaves room).
+  for (int side : {-1, 1}) {
+    double arc = rng.Uniform(0, 5);
+    const double circumference = 2 * M_PI * axis;
+    while (arc < circumference - 8) {
+      const double length = std::min(rng.Uniform(8, 20), circumference - arc - 2);
+      const double height = rng.Uniform(8, 25), depth = 10.0;
+      const double setback = 11.0 + rng.Uniform(0, 4);
+      const double offset = side * (setback + depth / 2);
+      if (axis + offset - depth / 2 > 3.0) {
+        Box building = MakeBox(on_ring((arc + length / 2) / axis, offset, height / 2),
+                               {length / 2, depth / 2, height / 2}, 0);
+        const cv::Vec3f tint = RandomTint(rng, 0.6f, 1.1f);
+        const int front = textures.Make(TextureStyle::kFacade, length, height, 0.05, tint);
+        const int ends = textures.Make(TextureStyle::kFacade, depth, height, 0.05, tint);
+        building.face_texture = {ends, ends, front, front, front, front};
+        scene.static_boxes.push_back(building);
+      }
+      arc += length + (rng.Uniform() < 0.5 ? 0.5 : rng.Uniform(2, 6));
+    }
+  }
+  // Parked cars in the parking lanes, heading either way.
+  int parked = 0;
+  for (int side : {-1, 1}) {
+    for (double arc = rng.Uniform(0, 10); arc < 2 * M_PI * axis - 10; arc += rng.Uniform(8, 25)) {
+      if (rng.Uniform() < 0.3) continue;
+      CarLook look;
+      look.paint = textures.ForBox(TextureStyle::kCarPaint, {2.1, 2.1, 2.1}, 0.01,
+                                   RandomTint(rng, 0.3f, 1.2f));
+      look.glass = textures.ForBox(TextureStyle::kDark, {1.1, 1.1, 1.1}, 0.01);
+      look.tyre =
+          textures.ForBox(TextureStyle::kDark, {0.93, 0.93, 0.93}, 0.01, {0.8f, 0.8f, 0.8f});
+      Rigid3d pose = on_ring(arc / axis, 5.6 * side, 0);
+      if (rng.Uniform() < 0.5) pose.linear() = pose.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      const int id = scene.AddObject("parked-car-" + std::to_string(++parked), 2, false);
+      AppendCar(pose, look, id, scene.static_boxes);
+    }
+  }
+
+  MotionSpec motion;
+  motion.kind = MotionKind::kLoop;
+  motion.loop_centre = {0, 0, 1.65};
+  motion.loop_radii = {camera_radius, camera_radius};
+  motion.loop_period_s = period;
+  motion.loop_start_rad = 0.0;
+  motion.loop_look_ahead = true;
+  motion.loop_pitch_rad = 0.0;
+  motion.jitter_translation_m = 0.01;
+  motion.jitter_rotation_rad = 0.002;
+  motion.seed = SubSeed(options.seed, 0xCA5);
+  scene.world_from_cam = MakeCameraTrajectory(motion);
+}
+
 }  // namespace
 
 void SceneOptions::Check() const {
@@ -293,6 +403,8 @@ Scene BuildScene(const SceneOptions& options) {
   scene.name = options.scene;
   if (options.scene == "office") {
     BuildOffice(options, scene);
+  } else if (options.motion == MotionKind::kLoop) {
+    BuildStreetLoop(options, scene);
   } else {
     BuildStreet(options, scene);
   }

@@ -17,7 +17,7 @@
 
   const COLORS = {
     est: '#e8590c', gt: '#343a40', err: '#c92a2a', scale: '#5f3dc4', inliers: '#1971c2',
-    kf: '#1971c2', reloc: '#f08c00', lost: 'rgba(224, 49, 49, 0.16)', uninit: 'rgba(134, 142, 150, 0.18)',
+    kf: '#1971c2', reloc: '#f08c00', loop: '#9c36b5', lost: 'rgba(224, 49, 49, 0.16)', uninit: 'rgba(134, 142, 150, 0.18)',
   };
   const AXIS_COLORS = ['#d9480f', '#2b8a3e', '#1864ab'];
   const STAGE_COLORS = {
@@ -98,6 +98,12 @@
               if (F.relocalised[i] === 1) {
                 ctx.strokeStyle = COLORS.reloc;
                 ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, top + h); ctx.stroke();
+              }
+              if (F.loop && F.loop[i] === 1) {
+                ctx.strokeStyle = COLORS.loop;
+                ctx.lineWidth = 3 * Math.max(1, devicePixelRatio);
+                ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, top + h); ctx.stroke();
+                ctx.lineWidth = Math.max(1, devicePixelRatio);
               }
               if (F.keyframe[i] === 1) {
                 ctx.strokeStyle = COLORS.kf;
@@ -415,7 +421,9 @@
     tlPanel.appendChild(el('div', { class: 'legend-row' },
       el('span', {}, swatch(COLORS.lost), 'lost'), el('span', {}, swatch(COLORS.uninit), 'not initialised'),
       el('span', {}, swatch(COLORS.reloc), 'relocalised'), el('span', {}, swatch(COLORS.kf), 'keyframe (tick)'),
+      el('span', {}, swatch(COLORS.loop), 'loop closed'),
       el('span', {}, fmt(F.keyframe.reduce((a, b) => a + b, 0), 0) + ' keyframes, ' + fmt(F.relocalised.reduce((a, b) => a + b, 0), 0) + ' relocalisations, ' +
+        fmt((F.loop || []).reduce((a, b) => a + b, 0), 0) + ' loops, ' +
         fmt(F.state.filter((s) => s === 2).length, 0) + ' lost frames')));
     const tl = el('div', { id: 'plot-timeline' });
     tlPanel.appendChild(tl);

@@ -1,0 +1,100 @@
+#include "ademono/optimize/pose_graph.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace ademono {
+namespace {
+
+// A ring of n cameras on a circle (radius 2 m), each looking outwards.
+std::vector<Sim3d> Ring(int n) {
+  std::vector<Sim3d> poses;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    Rigid3d world_from_cam = Rigid3d::Identity();
+    world_from_cam.linear() = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    world_from_cam.translation() = Eigen::Vector3d(2 * std::cos(a), 2 * std::sin(a), 0);
+    poses.push_back(Sim3d::FromRigid(world_from_cam.inverse()));
+  }
+  return poses;
+}
+
+double MaxCentreError(const std::vector<Sim3d>& a, const std::vector<Sim3d>& b) {
+  double worst = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    const Eigen::Vector3d ca = a[k].Inverse().translation, cb = b[k].Inverse().translation;
+    worst = std::max(worst, (ca - cb).norm());
+  }
+  return worst;
+}
+
+TEST(Sim3d, ComposeAndInverse) {
+  Sim3d s;
+  s.scale = 1.3;
+  s.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  s.translation = {0.5, -1, 2};
+  const Eigen::Vector3d x(0.3, 0.2, -0.7);
+  EXPECT_LT(((s.Inverse() * s) * x - x).norm(), 1e-12);
+  EXPECT_LT((s * (s.Inverse() * x) - x).norm(), 1e-12);
+  const Rigid3d r = s.ToRigid();
+  EXPECT_LT((r.translation() - s.translation / 1.3).norm(), 1e-12);
+}
+
+// Odometry that drifted in scale and heading around a ring, closed by one loop edge: the Sim(3)
+// graph spreads the correction; SE(3) cannot undo a scale drift as well.
+TEST(PoseGraph, LoopEdgeRemovesAccumulatedDrift) {
+  const int n = 24;
+  const std::vector<Sim3d> truth = Ring(n);
+  // Drifted chain: each odometry step shrinks the scale by 3 % (a Sim(3) step, as a drifting
+  // network scale) and adds a 1 degree error about the camera's y axis, accumulated from the
+  // first (fixed) camera.
+  std::vector<Sim3d> drifted{truth[0]};
+  PoseGraphProblem problem;
+  for (int k = 1; k < n; ++k) {
+    Sim3d step = truth[k] * truth[k - 1].Inverse();  // cam_k_from_cam_{k-1}
+    Sim3d noisy = step;
+    noisy.scale = 0.97;
+    noisy.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())) *
+                     noisy.rotation;
+    drifted.push_back(noisy * drifted.back());
+    // The edges measure the drifted odometry.
+    problem.edges.push_back({static_cast<size_t>(k), static_cast<size_t>(k - 1), noisy});
+  }
+  // The loop edge: the last camera relative to the first, measured correctly.
+  problem.edges.push_back({static_cast<size_t>(n - 1), 0, truth[n - 1] * truth[0].Inverse()});
+  problem.cam_from_world = drifted;
+  problem.fixed.assign(n, false);
+  problem.fixed[0] = true;
+  problem.iterations = 50;
+  const double before = MaxCentreError(drifted, truth);
+  ASSERT_GT(before, 0.5);
+  const PoseGraphResult result = SolvePoseGraph(problem);
+  EXPECT_LT(result.final_cost, result.initial_cost);
+  // The loop edge pulls the last camera back onto the first one's measured relation.
+  const Sim3d last = result.cam_from_world[n - 1];
+  const Eigen::Vector3d gap = last.Inverse().translation - truth[n - 1].Inverse().translation;
+  EXPECT_LT(gap.norm(), 0.5 * (drifted[n - 1].Inverse().translation -
+                               truth[n - 1].Inverse().translation)
+                                  .norm());
+  EXPECT_LT(MaxCentreError(result.cam_from_world, truth), 0.6 * before);
+  // The fixed vertex does not move.
+  EXPECT_LT((result.cam_from_world[0].translation - truth[0].translation).norm(), 1e-12);
+
+  PoseGraphProblem se3 = problem;
+  se3.fix_scale = true;
+  const PoseGraphResult rigid = SolvePoseGraph(se3);
+  // SE(3): every scale keeps its start value.
+  for (int k = 0; k < n; ++k) EXPECT_NEAR(rigid.cam_from_world[k].scale, drifted[k].scale, 1e-12);
+}
+
+TEST(PoseGraph, RejectsBadEdges) {
+  PoseGraphProblem problem;
+  problem.cam_from_world = Ring(3);
+  problem.fixed = {true, false, false};
+  problem.edges.push_back({0, 5, Sim3d()});
+  EXPECT_THROW(SolvePoseGraph(problem), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ademono

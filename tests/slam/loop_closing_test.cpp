@@ -1,0 +1,121 @@
+// Loop closing on rendered sequences with exact ground truth: the office loop (one lap in 85 % of
+// the sequence, then the first views again) with the simulated network's scale drift, closed and
+// not closed; and sequences that never come back to a place, which must close no loop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "ademono/depth/simulated_depth.h"
+#include "ademono/eval/trajectory_eval.h"
+#include "ademono/slam/system.h"
+#include "ademono/synth/generator.h"
+#include "ademono/synth/scenes.h"
+
+namespace ademono {
+namespace {
+
+struct LoopRun {
+  std::vector<LoopEvent> loops;
+  Trajectory estimate, truth;
+  int tracked = 0;
+  double ate_sim3 = 0;
+};
+
+SystemOptions NetworkOptions(bool loop) {
+  SystemOptions options;
+  options.orb.num_features = 1000;
+  options.depth.virtual_baseline = 0.03;
+  options.depth.close_depth_factor = 107;
+  options.depth.error_relative = 0.5;
+  options.depth.edge_radius = 3;
+  options.depth.edge_relative_slope = 0.2;
+  options.tracking.min_init_points = 50;
+  options.tracking.close_tracked_min = 250;
+  options.mapping.ba_max_keyframes = 20;
+  options.mapping.triangulation = true;
+  options.filter.enable_dynamic_removal = false;
+  options.loop.enabled = loop;
+  return options;
+}
+
+LoopRun RunScene(const synth::SceneOptions& scene_options, const SystemOptions& options,
+            uint64_t depth_seed) {
+  const synth::Scene scene = synth::BuildScene(scene_options);
+  synth::GeneratorOptions generator;
+  generator.scene = scene_options;
+  SimulatedDepthOptions depth_options;
+  depth_options.scale = 0.88;
+  depth_options.jitter = 0.16;
+  depth_options.jitter_frames = 200;
+  depth_options.seed = depth_seed;
+  const SimulatedDepthProvider network(depth_options, nullptr);
+  LoopRun run;
+  System system(scene.camera, options);
+  for (size_t k = 0; k < scene_options.frames; ++k) {
+    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, k, generator);
+    FrameData frame;
+    frame.index = k;
+    frame.timestamp = scene.TimeOf(k);
+    frame.image = rendered.image;
+    run.tracked += system.TrackFrame(frame, network.Degrade(rendered.depth, k), {}).tracked;
+    run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
+  }
+  system.Shutdown();
+  run.loops = system.Loops();
+  run.estimate = system.FrameTrajectory();
+  EvalOptions eval;
+  eval.alignment = Alignment::kSim3;
+  run.ate_sim3 = EvaluateTrajectories(run.truth, run.estimate, eval).ape.rmse;
+  return run;
+}
+
+synth::SceneOptions OfficeLoop(size_t frames) {
+  synth::SceneOptions o;
+  o.scene = "office";
+  o.motion = synth::MotionKind::kLoop;
+  o.frames = frames;
+  o.seed = 1;
+  o.persons = 1;
+  o.width = 320;
+  o.height = 240;
+  return o;
+}
+
+TEST(LoopClosingTest, OfficeLoopIsClosedAndReducesTheError) {
+  const size_t frames = 240;
+  const LoopRun closed = RunScene(OfficeLoop(frames), NetworkOptions(true), 3);
+  const LoopRun open = RunScene(OfficeLoop(frames), NetworkOptions(false), 3);
+  EXPECT_EQ(closed.tracked, static_cast<int>(frames));
+  EXPECT_TRUE(open.loops.empty());
+  ASSERT_FALSE(closed.loops.empty());
+  const LoopEvent& loop = closed.loops.front();
+  // The end of the lap (85 % of the frames) seen again at the start.
+  EXPECT_GT(loop.query_frame, frames * 3 / 4);
+  EXPECT_LT(loop.match_frame, frames / 8);
+  EXPECT_TRUE(loop.sim3);  // network depth: its scale drifts
+  EXPECT_GT(loop.correction_m, 0.0);
+  EXPECT_GE(loop.matches, 40);
+  // Measured 0.228 -> 0.137 m (0.60x). The acceptance asks for 0.5x: not reached yet
+  // (docs/loops.md), so this guards what there is.
+  EXPECT_LE(closed.ate_sim3, 0.7 * open.ate_sim3)
+      << "closed " << closed.ate_sim3 << " open " << open.ate_sim3;
+}
+
+TEST(LoopClosingTest, NoLoopWithoutARevisit) {
+  // Forward through the office (never back) and the street driving on: no place is seen twice.
+  synth::SceneOptions office;
+  office.scene = "office";
+  office.motion = synth::MotionKind::kForward;
+  office.frames = 80;
+  office.seed = 2;
+  office.persons = 1;
+  office.width = 320;
+  office.height = 240;
+  const LoopRun run = RunScene(office, NetworkOptions(true), 4);
+  EXPECT_GT(run.tracked, 70);
+  EXPECT_TRUE(run.loops.empty());
+}
+
+}  // namespace
+}  // namespace ademono
