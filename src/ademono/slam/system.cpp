@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "ademono/core/timing.h"
+#include "ademono/filter/dynamic.h"
 
 namespace ademono {
 
@@ -182,10 +183,24 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
     if (judged > 0 && dynamic >= options_.filter.dynamic.box_vote_ratio * judged)
       moving_detections.push_back(d);
   }
+  // Kept keypoints inside a dynamic-class box (grown as the filter grows them): the geometric
+  // test starts the map points made from them at the lower box prior.
+  std::vector<uint8_t> in_dynamic_box;
+  if (options_.filter.enable_dynamic_removal && options_.tracking.static_test) {
+    const std::vector<GrownBox> boxes = GrowDynamicBoxes(
+        detections, cv::Size(camera_.width, camera_.height), options_.filter.dynamic);
+    if (!boxes.empty()) {
+      for (const cv::KeyPoint& kp : kept_keypoints) {
+        bool inside = false;
+        for (const GrownBox& b : boxes) inside = inside || InsideBox(b.box, kp.pt);
+        in_dynamic_box.push_back(inside ? 1 : 0);
+      }
+    }
+  }
   TrackingOutput out;
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
-    out = tracking_.Track(features, frame.index, frame.timestamp);
+    out = tracking_.Track(features, frame.index, frame.timestamp, std::move(in_dynamic_box));
     // The one rule for map points on moving objects: occlusion-aware, so it needs this frame's
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
     // background the box covers).
@@ -213,6 +228,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.inliers = out.inliers;
   result.relocalised = out.relocalised;
   result.dynamic_points_culled = out.dynamic_points_culled;
+  result.quality = out.quality;
+  result.geometric_dynamic = out.geometric_dynamic;
+  result.geometric_culled = out.geometric_culled;
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <opencv2/calib3d.hpp>
@@ -12,8 +13,15 @@
 #include "ademono/optimize/depth_scale.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
+#include "ademono/slam/static_probability.h"
 
 namespace ademono {
+namespace {
+
+// Static probability of a point with a history: about four agreeing frames more than against.
+constexpr double kTrustedStaticProbability = 0.8;
+
+}  // namespace
 
 const char* TrackingStateName(TrackingState state) {
   switch (state) {
@@ -25,6 +33,18 @@ const char* TrackingStateName(TrackingState state) {
       return "lost";
   }
   throw std::logic_error("TrackingStateName: unknown state");
+}
+
+const char* PoseQualityName(PoseQuality quality) {
+  switch (quality) {
+    case PoseQuality::kGood:
+      return "good";
+    case PoseQuality::kFewInliers:
+      return "few_static_points";
+    case PoseQuality::kMotionModel:
+      return "motion_model";
+  }
+  throw std::logic_error("PoseQualityName: unknown quality");
 }
 
 Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
@@ -44,7 +64,8 @@ int Tracking::CountDepthPoints(const Frame& frame) const {
 }
 
 TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                               double timestamp) {
+                               double timestamp, std::vector<uint8_t> in_dynamic_box) {
+  in_dynamic_box_ = std::move(in_dynamic_box);
   // Network depth starts from the last frame's correction (its scale wanders slowly).
   if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
     features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));
@@ -52,6 +73,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   Frame frame(next_frame_id_++, index, timestamp, std::move(features));
   TrackingOutput out;
   bool ok = false;
+  bool weak = false;
+  judged_dynamic_ = 0;
+  geometric_culled_ = 0;
 
   if (state_ == TrackingState::kNotInitialized) {
     ok = Initialise(frame, Rigid3d::Identity());
@@ -76,18 +100,44 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       out.relocalised = ok;
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (ok) ok = TrackLocalMap(frame);
+    // Crowds: when neither the motion model nor the reference keyframe found enough matches, the
+    // predicted pose can still find the static points left in the local map.
+    std::optional<Rigid3d> predicted;
+    if (state_ == TrackingState::kOk && options_.tracking.weak_pose_max_frames > 0)
+      predicted = PredictNext();
+    bool coarse = ok;
+    if (!ok && predicted) {
+      std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+      frame.cam_from_world = *predicted;
+      coarse = true;
+    }
+    if (coarse) ok = TrackLocalMap(frame);
+    // Degrade instead of dropping the frame (a short gap in the crowd, not a loss).
+    if (!ok && predicted && weak_streak_ < options_.tracking.weak_pose_max_frames) {
+      ok = weak = true;
+      if (frame.cam_from_world && matches_inliers_ >= options_.tracking.weak_pose_min_inliers) {
+        out.quality = PoseQuality::kFewInliers;
+      } else {
+        out.quality = PoseQuality::kMotionModel;
+        frame.cam_from_world = *predicted;
+        std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+        matches_inliers_ = 0;
+      }
+    }
 
     if (ok) {
-      if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
+      if (out.quality == PoseQuality::kMotionModel) {
+        // velocity_ stays: the prediction is all this frame has.
+      } else if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else {
         velocity_.reset();
       }
       state_ = TrackingState::kOk;
       lost_streak_ = 0;
-      CorrectDepthScale(frame, true);
-      if (NeedNewKeyFrame(frame)) {
+      weak_streak_ = weak ? weak_streak_ + 1 : 0;
+      if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
+      if (!weak && NeedNewKeyFrame(frame)) {
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame);
       }
@@ -98,6 +148,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     } else {
       state_ = TrackingState::kLost;
       velocity_.reset();
+      weak_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).
@@ -126,6 +177,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.tracked = true;
     out.cam_from_world = *frame.cam_from_world;
     out.inliers = matches_inliers_;
+    out.geometric_dynamic = judged_dynamic_;
+    out.geometric_culled = geometric_culled_;
     out.depth_scale = record.depth_scale = frame.F().depth_scale;
     if (frame.F().DepthIsPrior()) {
       last_depth_scale_ = frame.F().depth_scale;
@@ -145,9 +198,11 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
 }
 
 void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
-                                    const Rigid3d& world_from_cam, size_t i) {
+                                    const Rigid3d& world_from_cam, size_t i,
+                                    double static_probability) {
   auto point = map_.CreateMapPoint(world_from_cam * frame.F().UnprojectCamera(i), &keyframe,
                                    frame.id);
+  if (options_.tracking.static_test) point->static_probability = static_probability;
   point->AddObservation(&keyframe, i);
   keyframe.AddMapPoint(point, i);
   point->ComputeDistinctiveDescriptor();
@@ -163,7 +218,10 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (f.depth[i] <= 0) continue;
-    CreatePointFromDepth(frame, *kf, world_from_cam, i);
+    // The first map has nothing to be judged against: usable from the start.
+    CreatePointFromDepth(frame, *kf, world_from_cam, i,
+                         std::max(options_.tracking.static_params.prior,
+                                  options_.tracking.static_params.threshold));
   }
   frame.reference_keyframe = kf.get();
   reference_keyframe_ = kf.get();
@@ -187,7 +245,9 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
   std::vector<double> map_depths, frame_depths;
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || p->bad || !(f.depth[i] > 0) || (inliers_only && frame.outlier[i])) continue;
+    if (!p || p->bad || !UsableForPose(*p) || !(f.depth[i] > 0) ||
+        (inliers_only && frame.outlier[i]))
+      continue;
     map_depths.push_back((*frame.cam_from_world * p->position).z());
     frame_depths.push_back(f.depth[i]);
   }
@@ -226,14 +286,15 @@ void Tracking::RescaleWorld(Frame& frame, double factor) {
   last_depth_scale_ *= factor;
 }
 
-int Tracking::OptimizeFramePose(Frame& frame) {
+int Tracking::OptimizeFramePose(Frame& frame, double min_static) {
   CorrectDepthScale(frame, false);
   std::vector<PoseObservation> observations;
   std::vector<size_t> indices;
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || p->bad) continue;
+    if (!p || p->bad || !UsableForPose(*p)) continue;
+    if (options_.tracking.static_test && p->static_probability < min_static) continue;
     observations.push_back({p->position, f.Observation(i)});
     indices.push_back(i);
   }
@@ -256,7 +317,7 @@ int Tracking::DiscardOutliers(Frame& frame) {
       p->last_frame_seen = frame.id;
       p.reset();
       frame.outlier[i] = false;
-    } else if (p->NumObservations() > 0) {
+    } else if (p->NumObservations() > 0 && UsableForPose(*p)) {
       ++in_map;
     }
   }
@@ -362,18 +423,53 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     predictions.push_back(prediction);
   }
   const bool recently_relocalised = frame.id < last_reloc_frame_id_ + 2;
+  // After a weak pose (a crowd hid the scene) the prediction is less sure: a wider window.
   const float radius = static_cast<float>(options_.tracking.local_search_radius) *
-                       (recently_relocalised ? 1.7f : 1.f);
+                       (recently_relocalised ? 1.7f : 1.f) * (weak_streak_ > 0 ? 2.f : 1.f);
   const Matcher matcher(0.8f, false);
   matcher.SearchByProjection(frame, candidates, predictions, radius);
 
-  OptimizeFramePose(frame);
-  matches_inliers_ = 0;
+  auto count_inliers = [&frame] {
+    int n = 0;
+    for (size_t i = 0; i < frame.map_points.size(); ++i) {
+      const auto& p = frame.map_points[i];
+      if (p && !frame.outlier[i] && p->NumObservations() > 0) ++n;
+    }
+    return n;
+  };
+  if (options_.tracking.static_test) {
+    // Coarse to fine: the pose first from the points with a long static history alone, when
+    // there are enough of them, and every match judged at that pose. A crowd that fills the view
+    // then cannot pull the pose along and turn the background's verdicts against it. A frame
+    // with dynamic boxes has had its movers removed by them already; there the few trusted
+    // points left between the boxes give a pose too weak to judge by (measured on bonn-crowd-a
+    // with YOLOX-nano: 20 frames lost instead of none), so all usable points pose it.
+    const Rigid3d start = *frame.cam_from_world;
+    const int trusted = in_dynamic_box_.empty()
+                            ? OptimizeFramePose(frame, kTrustedStaticProbability)
+                            : 0;
+    if (trusted >= options_.tracking.min_inliers) {
+      judged_dynamic_ = JudgeStaticness(frame);
+      OptimizeFramePose(frame);
+    } else {
+      frame.cam_from_world = start;
+      OptimizeFramePose(frame);
+      // Only a pose that rests on enough points judges the points (a weak one would teach the
+      // map its own error).
+      if (count_inliers() >= options_.tracking.min_inliers) judged_dynamic_ = JudgeStaticness(frame);
+    }
+    // The final optimisation reset the flags: points judged moving stay out.
+    for (size_t i = 0; i < frame.map_points.size(); ++i) {
+      const auto& p = frame.map_points[i];
+      if (p && !UsableForPose(*p)) frame.outlier[i] = true;
+    }
+  } else {
+    OptimizeFramePose(frame);
+  }
+  matches_inliers_ = count_inliers();
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || frame.outlier[i]) continue;
-    ++p->found;
-    if (p->NumObservations() > 0) ++matches_inliers_;
+    if (p && !frame.outlier[i]) ++p->found;
   }
   const uint64_t reloc_window =
       static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
@@ -382,6 +478,50 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     return false;
   }
   return matches_inliers_ >= options_.tracking.min_inliers;
+}
+
+bool Tracking::UsableForPose(const MapPoint& point) const {
+  return !options_.tracking.static_test ||
+         point.static_probability >= options_.tracking.static_params.threshold;
+}
+
+int Tracking::JudgeStaticness(Frame& frame) {
+  const FrameFeatures& f = frame.F();
+  const StaticTestParams& params = options_.tracking.static_params;
+  // A point at the floor has been seen moving again and again: out of the map, so that local BA
+  // and matching stop meeting it.
+  constexpr double kCullProbability = 0.05;
+  std::vector<MapPoint*> cull;
+  int dynamic = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p || p->bad) continue;
+    const Eigen::Vector3d cam = *frame.cam_from_world * p->position;
+    double residual = std::numeric_limits<double>::infinity();
+    std::optional<double> depth_error;
+    if (cam.z() > 0) {
+      const cv::KeyPoint& kp = f.keypoints_un[i];
+      const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
+      const double v = f.intrinsics.fy * cam.y() / cam.z() + f.intrinsics.cy;
+      // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
+      const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
+      residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
+      if (f.depth[i] > 0) depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+    }
+    p->static_probability = UpdateStaticProbability(
+        p->static_probability, JudgeObservation(residual, depth_error, params));
+    if (UsableForPose(*p)) continue;
+    ++dynamic;
+    frame.outlier[i] = true;
+    if (p->static_probability <= kCullProbability) {
+      cull.push_back(p.get());
+      p.reset();
+      frame.outlier[i] = false;
+    }
+  }
+  for (MapPoint* p : cull) map_.ErasePoint(p);
+  geometric_culled_ += static_cast<int>(cull.size());
+  return dynamic;
 }
 
 bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
@@ -444,7 +584,11 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
   int considered = 0;
   for (const auto& [z, i] : by_depth) {
     if (!kf->map_points[i]) {
-      CreatePointFromDepth(frame, *kf, world_from_cam, i);
+      // Boxes raise the prior of motion; geometry decides.
+      const bool boxed = i < in_dynamic_box_.size() && in_dynamic_box_[i];
+      CreatePointFromDepth(frame, *kf, world_from_cam, i,
+                           boxed ? options_.tracking.static_params.box_prior
+                                 : options_.tracking.static_params.prior);
       frame.outlier[i] = false;
     }
     ++considered;
