@@ -33,8 +33,8 @@ struct AblateArgs : SequenceRunArgs {
 };
 
 std::vector<AblationVariant> SelectVariants(const std::string& list) {
-  const auto& all = DefaultAblationVariants();
-  if (list.empty()) return all;
+  const auto& all = AllAblationVariants();
+  if (list.empty()) return DefaultAblationVariants();
   std::vector<AblationVariant> chosen;
   std::stringstream ss(list);
   std::string name;
@@ -120,7 +120,8 @@ const bool kRegistered = RegisterCommand(
       AddSequenceRunOptions(app, *args);
       app.add_option("--variants", args->variants,
                      "comma-separated subset of full,no_dynamic,no_distant,"
-                     "no_dynamic_no_distant,no_enhancement (default: all)");
+                     "no_dynamic_no_distant,no_enhancement,boxes_only,geometry_only (default: "
+                     "the first five)");
       return [args] { return Ablate(*args); };
     });
 

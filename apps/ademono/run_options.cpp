@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <regex>
 
@@ -52,25 +53,52 @@ fs::path FindConfigDir() {
   return {};
 }
 
-std::string DefaultConfigName(const std::string& kind, const std::string& path) {
-  if (kind == "tum") {
-    std::smatch m;
-    if (std::regex_search(path, m, std::regex("(freiburg|fr)([123])")))
-      return "tum_fr" + m[2].str() + ".yaml";
-    return "tum_fr1.yaml";
+namespace {
+
+// The three TUM Kinects by their published intrinsics (io/sequence_tum.cpp), so that a TUM-layout
+// folder is recognised by its camera, not by its name.
+std::string TumKinectOf(const Camera& camera) {
+  struct Kinect {
+    const char* name;
+    double fx, fy, cx, cy;
+  };
+  static const Kinect kKinects[] = {{"tum_fr1.yaml", 517.3, 516.5, 318.6, 255.3},
+                                    {"tum_fr2.yaml", 520.9, 521.0, 325.1, 249.7},
+                                    {"tum_fr3.yaml", 535.4, 539.2, 320.1, 247.6}};
+  if (camera.width != 640 || camera.height != 480) return {};
+  for (const Kinect& k : kKinects) {
+    if (std::abs(camera.fx - k.fx) < 1.0 && std::abs(camera.fy - k.fy) < 1.0 &&
+        std::abs(camera.cx - k.cx) < 1.0 && std::abs(camera.cy - k.cy) < 1.0)
+      return k.name;
   }
+  return {};
+}
+
+}  // namespace
+
+ConfigChoice DefaultConfig(const std::string& kind, const std::string& path, const Camera& camera) {
+  if (kind == "tum") {
+    const std::string kinect = TumKinectOf(camera);
+    if (!kinect.empty())
+      return {kinect, "a TUM RGB-D freiburg" + kinect.substr(6, 1) + " Kinect by its intrinsics"};
+    // Another sensor in the TUM layout (Bonn RGB-D Dynamic, own recordings): no Kinect's tuning.
+    return {"rgbd_generic.yaml",
+            fmt::format("a TUM-layout folder whose camera (fx {:.1f}, {}x{}) is no TUM Kinect",
+                        camera.fx, camera.width, camera.height)};
+  }
+  const std::string why = "the " + kind + " dataset family";
   if (kind == "kitti") {
     std::smatch m;
     int sequence = 0;
     if (std::regex_search(path, m, std::regex("(\\d{2})(?!.*\\d)")))
       sequence = std::stoi(m[1].str());
-    if (sequence <= 2) return "kitti_00-02.yaml";
-    if (sequence == 3) return "kitti_03.yaml";
-    return "kitti_04-12.yaml";
+    if (sequence <= 2) return {"kitti_00-02.yaml", why};
+    if (sequence == 3) return {"kitti_03.yaml", why};
+    return {"kitti_04-12.yaml", why};
   }
-  if (kind == "7scenes") return "7scenes.yaml";
-  if (kind == "euroc") return "euroc.yaml";
-  return kind + ".yaml";
+  if (kind == "7scenes") return {"7scenes.yaml", why};
+  if (kind == "euroc") return {"euroc.yaml", why};
+  return {kind + ".yaml", why};
 }
 
 fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequence,
@@ -81,8 +109,10 @@ fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequen
   }
   const fs::path dir = FindConfigDir();
   const DepthSourceInfo depth = DescribeDepthSource(depth_arg);
-  std::string name = DefaultConfigName(sequence.Kind(), sequence.Path().string());
-  std::string why = "the " + sequence.Kind() + " dataset family";
+  const ConfigChoice choice =
+      DefaultConfig(sequence.Kind(), sequence.Path().string(), sequence.GetCamera());
+  std::string name = choice.name;
+  std::string why = choice.why;
   if (depth.network) {
     const bool outdoor = depth.domain == "outdoor" || (depth.domain.empty() && sequence.Kind() == "kitti");
     name = outdoor ? "network_outdoor.yaml" : "network_indoor.yaml";

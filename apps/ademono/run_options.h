@@ -37,9 +37,14 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args);
 // Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
 // binary was built from (bin/ is build/<name>/bin). Empty when none is found.
 std::filesystem::path FindConfigDir();
-// The family config for a dataset: tum_fr1/2/3 by the "freiburgN" / "frN" in the path, kitti by
-// sequence number (00-02, 03, 04-12), else <kind>.yaml.
-std::string DefaultConfigName(const std::string& kind, const std::string& path);
+struct ConfigChoice {
+  std::string name;  // file name in configs/
+  std::string why;   // logged with the choice
+};
+// The default config of a dataset: by the sequence's camera where the family holds several
+// sensors (tum: the three Kinects by their intrinsics, anything else rgbd_generic.yaml), else by
+// the family (and KITTI's sequence number in the path).
+ConfigChoice DefaultConfig(const std::string& kind, const std::string& path, const Camera& camera);
 // `config_arg` if given, else the family's file; empty (with a warning) when there is none.
 // Depth from a network (`depth_arg` model:...) picks network_indoor.yaml, or
 // network_outdoor.yaml for a spec with `domain: outdoor` or a KITTI dataset. Logs the choice.

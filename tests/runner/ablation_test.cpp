@@ -93,10 +93,11 @@ TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
   EXPECT_EQ(results[1].filters.boxes_large, 0);
 
   const std::string md = AblationMarkdown(results);
-  EXPECT_NE(md.find("| variant | enh | dyn | dist | ATE se3 (m) | ATE sim3 (m) | tracked |"),
-            std::string::npos);
-  EXPECT_NE(md.find("| full | on | on | on |"), std::string::npos);
-  EXPECT_NE(md.find("| no_dynamic | on | off | on |"), std::string::npos);
+  EXPECT_NE(
+      md.find("| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked |"),
+      std::string::npos);
+  EXPECT_NE(md.find("| full | on | on | on | on | on |"), std::string::npos);
+  EXPECT_NE(md.find("| no_dynamic | on | off | on | off | on |"), std::string::npos);
   std::ifstream json_file(out / "ablation.json");
   const nlohmann::json json = nlohmann::json::parse(json_file);
   ASSERT_EQ(json["variants"].size(), 2u);
@@ -140,6 +141,19 @@ TEST(AblationTest, DefaultVariantsAreTheFivePaperVariants) {
   EXPECT_FALSE(v[3].dynamic_removal || v[3].distant_filter);
   EXPECT_FALSE(v[4].enhancement);
   EXPECT_TRUE(v[4].dynamic_removal && v[4].distant_filter);
+  // No dynamic handling at all: the geometric test goes with the boxes.
+  EXPECT_FALSE(v[1].geometric_test || v[3].geometric_test);
+}
+
+TEST(AblationTest, AllVariantsAddBoxesOnlyAndGeometryOnly) {
+  const auto& all = AllAblationVariants();
+  ASSERT_EQ(all.size(), 7u);
+  EXPECT_EQ(all[5].name, "boxes_only");
+  EXPECT_TRUE(all[5].use_detector && all[5].dynamic_removal);
+  EXPECT_FALSE(all[5].geometric_test);
+  EXPECT_EQ(all[6].name, "geometry_only");
+  EXPECT_FALSE(all[6].use_detector);
+  EXPECT_TRUE(all[6].geometric_test);
 }
 
 }  // namespace

@@ -136,10 +136,13 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
                                    "frames",    "tracked",       "untracked",     "lost",
                                    "keyframes", "map_points",    "wall_seconds",  "fps",
                                    "timing",    "filter_counts", "accuracy",      "per_frame",
-                                   "loops"}));
+                                   "loops",     "weak_poses",    "geometric_test"}));
   // A short xyz sequence revisits no place away from the live map: no loop.
   EXPECT_TRUE(s["loops"].is_array());
   EXPECT_TRUE(s["loops"].empty());
+  EXPECT_EQ(Keys(s["weak_poses"]), (std::set<std::string>{"few_static_points", "motion_model"}));
+  EXPECT_EQ(Keys(s["geometric_test"]),
+            (std::set<std::string>{"enabled", "matches_judged_dynamic", "map_points_culled"}));
   EXPECT_EQ(Keys(s["filters"]),
             (std::set<std::string>{"enhancement", "dynamic_removal", "distant"}));
   EXPECT_EQ(Keys(s["timing"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
@@ -159,13 +162,17 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
     EXPECT_EQ(Keys(f),
               (std::set<std::string>{"frame", "timestamp", "tracked", "state", "relocalised",
                                      "keyframe", "keypoints", "kept", "with_depth", "inliers",
-                                     "dynamic_points_culled", "filter", "ms"}))
+                                     "dynamic_points_culled", "pose_quality", "static_points",
+                                     "geometric_dynamic", "geometric_culled", "filter", "ms"}))
         << i;
     EXPECT_EQ(Keys(f["ms"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
                                                     "tracking", "mapping"}));
     EXPECT_EQ(f["frame"], i);
     EXPECT_EQ(f["state"], TrackingStateName(r.per_frame[i].state));
     EXPECT_EQ(f["kept"], r.per_frame[i].kept);
+    EXPECT_EQ(f["static_points"], r.per_frame[i].tracked ? r.per_frame[i].inliers : 0);
+    EXPECT_EQ(f["pose_quality"],
+              r.per_frame[i].tracked ? PoseQualityName(r.per_frame[i].quality) : "none");
     removed_dynamic += f["filter"]["removed_small_box"].get<long long>() +
                        f["filter"]["removed_stage1"].get<long long>() +
                        f["filter"]["removed_stage2"].get<long long>() +

@@ -31,13 +31,14 @@ std::vector<fs::path> ShippedConfigs() {
 TEST(ConfigsTest, AllFamilyConfigsParse) {
   int count = 0;
   for (const char* name : {"tum_fr1.yaml", "tum_fr2.yaml", "tum_fr3.yaml", "kitti_00-02.yaml",
-                           "kitti_03.yaml", "kitti_04-12.yaml", "euroc.yaml", "7scenes.yaml"}) {
+                           "kitti_03.yaml", "kitti_04-12.yaml", "euroc.yaml", "7scenes.yaml",
+                           "rgbd_generic.yaml"}) {
     const fs::path path = kConfigDir / name;
     ASSERT_TRUE(fs::exists(path)) << path;
     EXPECT_NO_THROW(SystemOptions::FromYaml(YAML::LoadFile(path.string()), path)) << path;
     ++count;
   }
-  EXPECT_EQ(count, 8);
+  EXPECT_EQ(count, 9);
   const SystemOptions kitti =
       SystemOptions::FromYaml(YAML::LoadFile((kConfigDir / "kitti_00-02.yaml").string()), "k");
   EXPECT_EQ(kitti.orb.num_features, 2000);

@@ -209,6 +209,10 @@ json FramesJson(const RunFolder& run, double t0) {
   for (const char* k : {"frame", "t", "tracked", "state", "relocalised", "keyframe"})
     cols[k] = json::array();
   for (const auto& k : ints) cols[k] = json::array();
+  // Optional (runs before the geometric test lack them): -1 = not recorded, left out of the plot.
+  const std::vector<std::string> optional_ints = {"static_points", "geometric_dynamic"};
+  for (const auto& k : optional_ints) cols[k] = json::array();
+  cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model
   json filter = json::object(), ms = json::object(), depth_scale = json::array();
   bool any_scale = false;
   size_t i = 0;
@@ -226,6 +230,9 @@ json FramesJson(const RunFolder& run, double t0) {
       cols["relocalised"].push_back(f.at("relocalised").get<bool>() ? 1 : 0);
       cols["keyframe"].push_back(f.at("keyframe").get<bool>() ? 1 : 0);
       for (const auto& k : ints) cols[k].push_back(f.at(k).get<int>());
+      for (const auto& k : optional_ints) cols[k].push_back(f.value(k, -1));
+      const std::string quality = f.value("pose_quality", std::string("good"));
+      cols["weak"].push_back(quality == "few_static_points" ? 1 : quality == "motion_model" ? 2 : 0);
       // "filter" and "ms" may be absent, but then from every frame (checked below).
       if (f.contains("filter")) {
         for (const auto& [name, value] : f["filter"].items()) {

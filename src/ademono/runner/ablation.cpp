@@ -14,11 +14,21 @@ namespace ademono {
 const std::vector<AblationVariant>& DefaultAblationVariants() {
   static const std::vector<AblationVariant> variants{
       {"full", true, true, true},
-      {"no_dynamic", true, false, true},
+      {"no_dynamic", true, false, true, false},
       {"no_distant", true, true, false},
-      {"no_dynamic_no_distant", true, false, false},
+      {"no_dynamic_no_distant", true, false, false, false},
       {"no_enhancement", false, true, true},
   };
+  return variants;
+}
+
+const std::vector<AblationVariant>& AllAblationVariants() {
+  static const std::vector<AblationVariant> variants = [] {
+    std::vector<AblationVariant> v = DefaultAblationVariants();
+    v.push_back({"boxes_only", true, true, true, false, true});
+    v.push_back({"geometry_only", true, true, true, true, false});
+    return v;
+  }();
   return variants;
 }
 
@@ -30,7 +40,9 @@ nlohmann::json VariantResult::ToJson() const {
   j["variant"] = variant.name;
   j["filters"] = {{"enhancement", variant.enhancement},
                   {"dynamic_removal", variant.dynamic_removal},
-                  {"distant", variant.distant_filter}};
+                  {"distant", variant.distant_filter},
+                  {"geometric_test", variant.geometric_test},
+                  {"detector", variant.use_detector}};
   j["frames"] = frames;
   j["tracked"] = tracked;
   j["tracking_rate"] = frames > 0 ? static_cast<double>(tracked) / frames : 0.0;
@@ -55,6 +67,7 @@ VariantResult RunAblationVariant(const Sequence& sequence, DepthProvider* depth,
   run.system.filter.enable_enhancement = variant.enhancement;
   run.system.filter.enable_dynamic_removal = variant.dynamic_removal;
   run.system.filter.enable_distant_filter = variant.distant_filter;
+  run.system.tracking.static_test = variant.geometric_test;
   run.pipeline = options.pipeline;
   run.dataset = options.dataset;
   run.config = options.config;
@@ -64,7 +77,8 @@ VariantResult RunAblationVariant(const Sequence& sequence, DepthProvider* depth,
     run.on_frame = [&](const FrameData& frame, const std::vector<Detection>& detections,
                        const TrackResult& r) { options.on_frame(variant, frame, detections, r); };
   }
-  const RunReport report = RunSequence(sequence, depth, detector, run);
+  const RunReport report =
+      RunSequence(sequence, depth, variant.use_detector ? detector : nullptr, run);
   WriteRunOutputs(report, out_dir);
 
   VariantResult result;
@@ -96,10 +110,10 @@ std::string AblationMarkdown(const std::vector<VariantResult>& results) {
     return s.str();
   };
   const bool truth = !results.empty() && results.front().truth.has_value();
-  os << "| variant | enh | dyn | dist | ATE se3 (m) | ATE sim3 (m) | tracked | keyframes | "
+  os << "| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked | keyframes | "
         "removed enh | removed dyn (small/st1/st2/vote) | removed distant (of >Z_th) |";
   if (truth) os << " moving removed | static person removed |";
-  os << "\n|---|---|---|---|---|---|---|---|---|---|---|";
+  os << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|";
   if (truth) os << "---|---|";
   os << "\n";
   auto onoff = [](bool b) { return b ? "on" : "off"; };
@@ -107,6 +121,7 @@ std::string AblationMarkdown(const std::vector<VariantResult>& results) {
     const FilterTotals& f = r.filters;
     os << "| " << r.variant.name << " | " << onoff(r.variant.enhancement) << " | "
        << onoff(r.variant.dynamic_removal) << " | " << onoff(r.variant.distant_filter) << " | "
+       << onoff(r.variant.geometric_test) << " | " << onoff(r.variant.use_detector) << " | "
        << num(r.ate_se3_m, 4) << " | " << num(r.ate_sim3_m, 4) << " | " << r.tracked << "/"
        << r.frames << " | " << r.keyframes << " | " << f.removed_enhancement << " | "
        << f.RemovedDynamic() << " (" << f.removed_small_box << "/" << f.removed_stage1 << "/"

@@ -28,9 +28,17 @@ struct AblationVariant {
   bool enhancement = true;
   bool dynamic_removal = true;
   bool distant_filter = true;
+  // The geometric test for movers without a box (tracking.static_test); the no_dynamic variants
+  // switch it off with the box filter, so that they measure no dynamic handling at all.
+  bool geometric_test = true;
+  bool use_detector = true;  // false: the run sees no detections (geometry only)
 };
 // full, no_dynamic, no_distant, no_dynamic_no_distant, no_enhancement.
 const std::vector<AblationVariant>& DefaultAblationVariants();
+// The defaults plus boxes_only (the detector's boxes through the paper's two-stage rule, no
+// geometric test) and geometry_only (no detections, the geometric test alone): with a real
+// detector (`--detector model:...`) these compare what the boxes and the geometry each bring.
+const std::vector<AblationVariant>& AllAblationVariants();
 
 struct VariantResult {
   AblationVariant variant;

@@ -156,6 +156,9 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     f.with_depth = r.num_with_depth;
     f.inliers = r.inliers;
     f.dynamic_points_culled = r.dynamic_points_culled;
+    f.quality = r.quality;
+    f.geometric_dynamic = r.geometric_dynamic;
+    f.geometric_culled = r.geometric_culled;
     f.filter = r.filter_stats;
     report.per_frame.push_back(f);
     report.filter_totals.Add(r.filter_stats, r.num_keypoints);
@@ -219,6 +222,20 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
   j["tracked"] = report.Tracked();
   j["untracked"] = report.frames - report.Tracked();
   j["lost"] = report.lost;
+  {
+    // Tracked frames by what their pose rests on, and the geometric test's totals.
+    int few = 0, motion = 0, geometric_dynamic = 0, geometric_culled = 0;
+    for (const FrameReport& f : report.per_frame) {
+      few += f.tracked && f.quality == PoseQuality::kFewInliers;
+      motion += f.tracked && f.quality == PoseQuality::kMotionModel;
+      geometric_dynamic += f.geometric_dynamic;
+      geometric_culled += f.geometric_culled;
+    }
+    j["weak_poses"] = {{"few_static_points", few}, {"motion_model", motion}};
+    j["geometric_test"] = {{"enabled", o.tracking.static_test},
+                           {"matches_judged_dynamic", geometric_dynamic},
+                           {"map_points_culled", geometric_culled}};
+  }
   j["keyframes"] = report.keyframes;
   j["map_points"] = report.map_points;
   j["wall_seconds"] = report.wall_seconds;
@@ -252,6 +269,10 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                          {"with_depth", f.with_depth},
                          {"inliers", f.inliers},
                          {"dynamic_points_culled", f.dynamic_points_culled},
+                         {"pose_quality", f.tracked ? PoseQualityName(f.quality) : "none"},
+                         {"static_points", f.tracked ? f.inliers : 0},
+                         {"geometric_dynamic", f.geometric_dynamic},
+                         {"geometric_culled", f.geometric_culled},
                          {"filter", FilterStatsJson(f.filter)},
                          {"ms",
                           {{"extraction", f.ms.extraction_ms},

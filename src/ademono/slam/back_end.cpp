@@ -125,7 +125,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   TrackingOutput& out = result.tracking;
   {
     std::lock_guard<std::mutex> lock(map_.mutex);
-    out = tracking_.Track(filtered.features, frame.index, frame.timestamp);
+    out = tracking_.Track(filtered.features, frame.index, frame.timestamp, filtered.in_dynamic_box);
     // The one rule for map points on moving objects: occlusion-aware, so it needs this frame's
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
     // background the box covers).

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "ademono/core/timing.h"
+#include "ademono/filter/dynamic.h"
 
 namespace ademono {
 
@@ -82,6 +83,19 @@ FilteredFrame FrontEnd::Filter(const ExtractedFrame& extracted,
     }
     if (judged > 0 && dynamic >= options_.filter.dynamic.box_vote_ratio * judged)
       out.moving_detections.push_back(d);
+  }
+  // Kept keypoints inside a dynamic-class box (grown as the filter grows them): the geometric
+  // test starts the map points made from them at the lower box prior.
+  if (options_.filter.enable_dynamic_removal && options_.tracking.static_test) {
+    const std::vector<GrownBox> boxes = GrowDynamicBoxes(
+        detections, cv::Size(camera_.width, camera_.height), options_.filter.dynamic);
+    if (!boxes.empty()) {
+      for (const cv::KeyPoint& kp : kept_keypoints) {
+        bool inside = false;
+        for (const GrownBox& b : boxes) inside = inside || InsideBox(b.box, kp.pt);
+        out.in_dynamic_box.push_back(inside ? 1 : 0);
+      }
+    }
   }
   out.features_ms = MsSince(start);
   return out;

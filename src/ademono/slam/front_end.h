@@ -9,6 +9,7 @@
 //             it runs in frame order.
 //   Remember: what the dynamic filter needs of this frame next time (after the back end).
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -41,6 +42,9 @@ struct FilteredFrame {
   std::shared_ptr<const FrameFeatures> features;  // the kept keypoints only
   // Detections that hold a moving object by the filter's vote (dynamic map-point culling).
   std::vector<Detection> moving_detections;
+  // Per kept keypoint: 1 inside a grown dynamic-class box (the geometric test's box prior);
+  // empty when the frame has no such box or the test is off.
+  std::vector<uint8_t> in_dynamic_box;
   double filter_ms = 0;    // filters and the kept subset
   double features_ms = 0;  // frame features and the moving-box vote
 };

@@ -34,6 +34,8 @@ class MapPoint {
   int visible = 1;  // frames in whose frustum the point was
   int found = 1;    // frames that matched it as an inlier
   int dynamic_hits = 0;
+  // P(static) of the geometric test (slam/static_probability.h); 1 when the test is off.
+  double static_probability = 1.0;
   bool bad = false;
   std::shared_ptr<MapPoint> replaced_by;
 

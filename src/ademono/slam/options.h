@@ -19,6 +19,7 @@
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/place/keyframe_database.h"
+#include "ademono/slam/static_probability.h"
 
 namespace ademono {
 
@@ -89,6 +90,17 @@ struct TrackingOptions {
   int relocalisation_keyframes = 20;  // most recent keyframes tried when lost
   int reinit_after_lost_frames = 10;  // lost this long: restart tracking from the last pose
   int dynamic_cull_hits = 3;          // map points seen this often inside dynamic boxes are culled
+  // Geometric test for movers without a box: each map point's static probability, judged by
+  // every frame that matches it; points below static_threshold are not used for the pose
+  // (slam/static_probability.h, docs/slam.md).
+  bool static_test = true;
+  StaticTestParams static_params;  // keys static_prior, static_threshold, ...
+  // Degrade instead of dropping a frame: when tracking fails while the last frame was tracked,
+  // the pose is still reported (weak) for up to weak_pose_max_frames frames in a row: optimised
+  // on its few static points when it keeps at least weak_pose_min_inliers, else the
+  // constant-velocity prediction. Weak frames make no keyframe. 0 disables.
+  int weak_pose_max_frames = 30;
+  int weak_pose_min_inliers = 10;
   void Check() const;
   static TrackingOptions FromYaml(const YAML::Node& node);
   YAML::Node ToYaml() const;

@@ -43,6 +43,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.inliers = out.inliers;
   result.relocalised = out.relocalised;
   result.dynamic_points_culled = out.dynamic_points_culled;
+  result.quality = out.quality;
+  result.geometric_dynamic = out.geometric_dynamic;
+  result.geometric_culled = out.geometric_culled;
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
   result.new_keyframe = back.new_keyframe;

@@ -34,6 +34,9 @@ struct TrackResult {
   int num_with_depth = 0;  // kept keypoints with valid depth
   int inliers = 0;
   int dynamic_points_culled = 0;  // map points culled for sitting in dynamic boxes
+  PoseQuality quality = PoseQuality::kGood;  // tracked frames: what the pose rests on
+  int geometric_dynamic = 0;  // matched map points the geometric test judged moving
+  int geometric_culled = 0;   // map points it culled
   double depth_scale = 1.0;       // network depth: this frame's scale correction
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -13,8 +14,15 @@
 #include "ademono/optimize/depth_scale.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/matcher.h"
+#include "ademono/slam/static_probability.h"
 
 namespace ademono {
+namespace {
+
+// Static probability of a point with a history: about four agreeing frames more than against.
+constexpr double kTrustedStaticProbability = 0.8;
+
+}  // namespace
 
 const char* TrackingStateName(TrackingState state) {
   switch (state) {
@@ -26,6 +34,18 @@ const char* TrackingStateName(TrackingState state) {
       return "lost";
   }
   throw std::logic_error("TrackingStateName: unknown state");
+}
+
+const char* PoseQualityName(PoseQuality quality) {
+  switch (quality) {
+    case PoseQuality::kGood:
+      return "good";
+    case PoseQuality::kFewInliers:
+      return "few_static_points";
+    case PoseQuality::kMotionModel:
+      return "motion_model";
+  }
+  throw std::logic_error("PoseQualityName: unknown quality");
 }
 
 Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
@@ -70,8 +90,9 @@ void Tracking::FollowLoopCorrection() {
 }
 
 TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                               double timestamp) {
+                               double timestamp, std::vector<uint8_t> in_dynamic_box) {
   FollowLoopCorrection();
+  in_dynamic_box_ = std::move(in_dynamic_box);
   // Network depth starts from the last frame's correction (its scale wanders slowly).
   if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
     features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));
@@ -79,6 +100,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   Frame frame(next_frame_id_++, index, timestamp, std::move(features));
   TrackingOutput out;
   bool ok = false;
+  bool weak = false;
+  judged_dynamic_ = 0;
+  geometric_culled_ = 0;
 
   if (state_ == TrackingState::kNotInitialized) {
     ok = Initialise(frame, Rigid3d::Identity());
@@ -119,37 +143,67 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       out.relocalised = ok;
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (ok && !odometry_only) {
-      // Localisation only: leaving the map's coverage, keep the motion model's odometry pose.
-      std::optional<Frame> odometry;
-      if (localize_only_ && by_motion) odometry = frame;
-      ok = TrackLocalMap(frame);
-      if (ok) {
-        visual_odometry_ = false;
-      } else if (odometry) {
-        frame = std::move(*odometry);
-        ok = visual_odometry_ = true;
+    if (localize_only_) {
+      if (ok && !odometry_only) {
+        // Localisation only: leaving the map's coverage, keep the motion model's odometry pose.
+        std::optional<Frame> odometry;
+        if (localize_only_ && by_motion) odometry = frame;
+        ok = TrackLocalMap(frame);
+        if (ok) {
+          visual_odometry_ = false;
+        } else if (odometry) {
+          frame = std::move(*odometry);
+          ok = visual_odometry_ = true;
+        }
       }
-    }
-    if (!ok && pristine && !by_motion) {
-      // E.g. just after a relocalisation, the local map was too thin: odometry from the last
-      // frame rather than a lost frame.
-      frame = std::move(*pristine);
-      ok = TrackWithMotionModel(frame);
-      if (ok) visual_odometry_ = true;
-      frame.reference_keyframe = reference_keyframe_;
+      if (!ok && pristine && !by_motion) {
+        // E.g. just after a relocalisation, the local map was too thin: odometry from the last
+        // frame rather than a lost frame.
+        frame = std::move(*pristine);
+        ok = TrackWithMotionModel(frame);
+        if (ok) visual_odometry_ = true;
+        frame.reference_keyframe = reference_keyframe_;
+      }
+    } else {
+      // Crowds: when neither the motion model nor the reference keyframe found enough matches, the
+      // predicted pose can still find the static points left in the local map.
+      std::optional<Rigid3d> predicted;
+      if (state_ == TrackingState::kOk && options_.tracking.weak_pose_max_frames > 0)
+        predicted = PredictNext();
+      bool coarse = ok;
+      if (!ok && predicted) {
+        std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+        frame.cam_from_world = *predicted;
+        coarse = true;
+      }
+      if (coarse) ok = TrackLocalMap(frame);
+      // Degrade instead of dropping the frame (a short gap in the crowd, not a loss).
+      if (!ok && predicted && weak_streak_ < options_.tracking.weak_pose_max_frames) {
+        ok = weak = true;
+        if (frame.cam_from_world && matches_inliers_ >= options_.tracking.weak_pose_min_inliers) {
+          out.quality = PoseQuality::kFewInliers;
+        } else {
+          out.quality = PoseQuality::kMotionModel;
+          frame.cam_from_world = *predicted;
+          std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+          matches_inliers_ = 0;
+        }
+      }
     }
 
     if (ok) {
-      if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
+      if (out.quality == PoseQuality::kMotionModel) {
+        // velocity_ stays: the prediction is all this frame has.
+      } else if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else {
         velocity_.reset();
       }
       state_ = TrackingState::kOk;
       lost_streak_ = 0;
-      CorrectDepthScale(frame, true);
-      if (!localize_only_ && NeedNewKeyFrame(frame)) {
+      weak_streak_ = weak ? weak_streak_ + 1 : 0;
+      if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
+      if (!localize_only_ && !weak && NeedNewKeyFrame(frame)) {
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame);
       }
@@ -161,6 +215,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     } else {
       state_ = TrackingState::kLost;
       velocity_.reset();
+      weak_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).
@@ -190,6 +245,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.tracked = true;
     out.cam_from_world = *frame.cam_from_world;
     out.inliers = matches_inliers_;
+    out.geometric_dynamic = judged_dynamic_;
+    out.geometric_culled = geometric_culled_;
     out.depth_scale = record.depth_scale = frame.F().depth_scale;
     if (frame.F().DepthIsPrior()) {
       last_depth_scale_ = frame.F().depth_scale;
@@ -209,9 +266,11 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
 }
 
 void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
-                                    const Rigid3d& world_from_cam, size_t i) {
+                                    const Rigid3d& world_from_cam, size_t i,
+                                    double static_probability) {
   auto point = map_.CreateMapPoint(world_from_cam * frame.F().UnprojectCamera(i), &keyframe,
                                    frame.id);
+  if (options_.tracking.static_test) point->static_probability = static_probability;
   point->AddObservation(&keyframe, i);
   keyframe.AddMapPoint(point, i);
   point->ComputeDistinctiveDescriptor();
@@ -227,7 +286,10 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (f.depth[i] <= 0) continue;
-    CreatePointFromDepth(frame, *kf, world_from_cam, i);
+    // The first map has nothing to be judged against: usable from the start.
+    CreatePointFromDepth(frame, *kf, world_from_cam, i,
+                         std::max(options_.tracking.static_params.prior,
+                                  options_.tracking.static_params.threshold));
   }
   frame.reference_keyframe = kf.get();
   reference_keyframe_ = kf.get();
@@ -251,7 +313,9 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
   std::vector<double> map_depths, frame_depths;
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || p->bad || !(f.depth[i] > 0) || (inliers_only && frame.outlier[i])) continue;
+    if (!p || p->bad || !UsableForPose(*p) || !(f.depth[i] > 0) ||
+        (inliers_only && frame.outlier[i]))
+      continue;
     map_depths.push_back((*frame.cam_from_world * p->position).z());
     frame_depths.push_back(f.depth[i]);
   }
@@ -291,14 +355,15 @@ void Tracking::RescaleWorld(Frame& frame, double factor) {
   last_depth_scale_ *= factor;
 }
 
-int Tracking::OptimizeFramePose(Frame& frame) {
+int Tracking::OptimizeFramePose(Frame& frame, double min_static) {
   CorrectDepthScale(frame, false);
   std::vector<PoseObservation> observations;
   std::vector<size_t> indices;
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || p->bad) continue;
+    if (!p || p->bad || !UsableForPose(*p)) continue;
+    if (options_.tracking.static_test && p->static_probability < min_static) continue;
     observations.push_back({p->position, f.Observation(i)});
     indices.push_back(i);
   }
@@ -321,7 +386,7 @@ int Tracking::DiscardOutliers(Frame& frame) {
       p->last_frame_seen = frame.id;
       p.reset();
       frame.outlier[i] = false;
-    } else if (p->NumObservations() > 0) {
+    } else if (p->NumObservations() > 0 && UsableForPose(*p)) {
       ++in_map;
     }
   }
@@ -449,18 +514,53 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     predictions.push_back(prediction);
   }
   const bool recently_relocalised = frame.id < last_reloc_frame_id_ + 2;
+  // After a weak pose (a crowd hid the scene) the prediction is less sure: a wider window.
   const float radius = static_cast<float>(options_.tracking.local_search_radius) *
-                       (recently_relocalised ? 1.7f : 1.f);
+                       (recently_relocalised ? 1.7f : 1.f) * (weak_streak_ > 0 ? 2.f : 1.f);
   const Matcher matcher(0.8f, false);
   matcher.SearchByProjection(frame, candidates, predictions, radius);
 
-  OptimizeFramePose(frame);
-  matches_inliers_ = 0;
+  auto count_inliers = [&frame] {
+    int n = 0;
+    for (size_t i = 0; i < frame.map_points.size(); ++i) {
+      const auto& p = frame.map_points[i];
+      if (p && !frame.outlier[i] && p->NumObservations() > 0) ++n;
+    }
+    return n;
+  };
+  if (options_.tracking.static_test) {
+    // Coarse to fine: the pose first from the points with a long static history alone, when
+    // there are enough of them, and every match judged at that pose. A crowd that fills the view
+    // then cannot pull the pose along and turn the background's verdicts against it. A frame
+    // with dynamic boxes has had its movers removed by them already; there the few trusted
+    // points left between the boxes give a pose too weak to judge by (measured on bonn-crowd-a
+    // with YOLOX-nano: 20 frames lost instead of none), so all usable points pose it.
+    const Rigid3d start = *frame.cam_from_world;
+    const int trusted = in_dynamic_box_.empty()
+                            ? OptimizeFramePose(frame, kTrustedStaticProbability)
+                            : 0;
+    if (trusted >= options_.tracking.min_inliers) {
+      judged_dynamic_ = JudgeStaticness(frame);
+      OptimizeFramePose(frame);
+    } else {
+      frame.cam_from_world = start;
+      OptimizeFramePose(frame);
+      // Only a pose that rests on enough points judges the points (a weak one would teach the
+      // map its own error).
+      if (count_inliers() >= options_.tracking.min_inliers) judged_dynamic_ = JudgeStaticness(frame);
+    }
+    // The final optimisation reset the flags: points judged moving stay out.
+    for (size_t i = 0; i < frame.map_points.size(); ++i) {
+      const auto& p = frame.map_points[i];
+      if (p && !UsableForPose(*p)) frame.outlier[i] = true;
+    }
+  } else {
+    OptimizeFramePose(frame);
+  }
+  matches_inliers_ = count_inliers();
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (!p || frame.outlier[i]) continue;
-    if (!localize_only_) ++p->found;
-    if (p->NumObservations() > 0) ++matches_inliers_;
+    if (p && !frame.outlier[i] && !localize_only_) ++p->found;
   }
   const uint64_t reloc_window =
       static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
@@ -469,6 +569,50 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     return false;
   }
   return matches_inliers_ >= options_.tracking.min_inliers;
+}
+
+bool Tracking::UsableForPose(const MapPoint& point) const {
+  return !options_.tracking.static_test ||
+         point.static_probability >= options_.tracking.static_params.threshold;
+}
+
+int Tracking::JudgeStaticness(Frame& frame) {
+  const FrameFeatures& f = frame.F();
+  const StaticTestParams& params = options_.tracking.static_params;
+  // A point at the floor has been seen moving again and again: out of the map, so that local BA
+  // and matching stop meeting it.
+  constexpr double kCullProbability = 0.05;
+  std::vector<MapPoint*> cull;
+  int dynamic = 0;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    auto& p = frame.map_points[i];
+    if (!p || p->bad) continue;
+    const Eigen::Vector3d cam = *frame.cam_from_world * p->position;
+    double residual = std::numeric_limits<double>::infinity();
+    std::optional<double> depth_error;
+    if (cam.z() > 0) {
+      const cv::KeyPoint& kp = f.keypoints_un[i];
+      const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
+      const double v = f.intrinsics.fy * cam.y() / cam.z() + f.intrinsics.cy;
+      // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
+      const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
+      residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
+      if (f.depth[i] > 0) depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+    }
+    p->static_probability = UpdateStaticProbability(
+        p->static_probability, JudgeObservation(residual, depth_error, params));
+    if (UsableForPose(*p)) continue;
+    ++dynamic;
+    frame.outlier[i] = true;
+    if (!localize_only_ && p->static_probability <= kCullProbability) {
+      cull.push_back(p.get());
+      p.reset();
+      frame.outlier[i] = false;
+    }
+  }
+  for (MapPoint* p : cull) map_.ErasePoint(p);
+  geometric_culled_ += static_cast<int>(cull.size());
+  return dynamic;
 }
 
 bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
@@ -531,7 +675,11 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
   int considered = 0;
   for (const auto& [z, i] : by_depth) {
     if (!kf->map_points[i]) {
-      CreatePointFromDepth(frame, *kf, world_from_cam, i);
+      // Boxes raise the prior of motion; geometry decides.
+      const bool boxed = i < in_dynamic_box_.size() && in_dynamic_box_[i];
+      CreatePointFromDepth(frame, *kf, world_from_cam, i,
+                           boxed ? options_.tracking.static_params.box_prior
+                                 : options_.tracking.static_params.prior);
       frame.outlier[i] = false;
     }
     ++considered;

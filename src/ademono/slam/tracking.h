@@ -24,6 +24,14 @@ enum class TrackingState { kNotInitialized, kOk, kLost };
 // "not_initialized" | "ok" | "lost" (summary.json, the Python API).
 const char* TrackingStateName(TrackingState state);
 
+// How much a tracked frame's pose rests on: kGood (enough static inliers against the local map),
+// kFewInliers (tracking failed its inlier bar but the pose is optimised on what is left, e.g.
+// when people fill the view), kMotionModel (nothing left to optimise on: the constant-velocity
+// prediction). Weak poses (the latter two) are reported, never made keyframes.
+enum class PoseQuality { kGood, kFewInliers, kMotionModel };
+// "good" | "few_static_points" | "motion_model" (summary.json per_frame, report.html).
+const char* PoseQualityName(PoseQuality quality);
+
 // What the trajectory needs of each input frame: its pose relative to a keyframe, so that later
 // keyframe corrections (local BA, culling) move it along.
 struct FrameRecord {
@@ -43,6 +51,11 @@ struct TrackingOutput {
   bool relocalised = false;
   bool reinitialised = false;
   int dynamic_points_culled = 0;
+  PoseQuality quality = PoseQuality::kGood;
+  // Geometric test: matched map points judged moving (not used for the pose) this frame, and
+  // map points culled for falling to the floor probability.
+  int geometric_dynamic = 0;
+  int geometric_culled = 0;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
 };
 
@@ -50,8 +63,11 @@ class Tracking {
  public:
   Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options);
 
+  // `in_dynamic_box`: per keypoint of `features`, 1 when it lies in a detector's dynamic box
+  // (the geometric test gives the map points made from it the lower static_box_prior); empty:
+  // no boxes.
   TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                       double timestamp);
+                       double timestamp, std::vector<uint8_t> in_dynamic_box = {});
 
   // After a loop correction moved the keyframes (Map::LoopCorrections changed): the last frame's
   // pose is re-derived from its reference keyframe. Called at every Track() and by System right
@@ -80,13 +96,21 @@ class Tracking {
   bool Relocalise(Frame& frame);
   bool NeedNewKeyFrame(const Frame& frame) const;
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame);
-  int OptimizeFramePose(Frame& frame);
+  // Motion-only pose optimisation on the matched points with static probability >= min_static
+  // (< 0: the geometric test's threshold).
+  int OptimizeFramePose(Frame& frame, double min_static = -1);
   int DiscardOutliers(Frame& frame);
   void UpdateLocalMap(Frame& frame);
   int CountDepthPoints(const Frame& frame) const;
+  // Geometric test: whether a map point's static probability lets it into the pose.
+  bool UsableForPose(const MapPoint& point) const;
+  // Judges every matched map point at the frame's pose, updates its static probability, marks
+  // the ones below the threshold as outliers and culls the ones at the floor. Returns how many
+  // are below the threshold.
+  int JudgeStaticness(Frame& frame);
   // A map point from keypoint i's depth, observed by `keyframe` (made from `frame`).
   void CreatePointFromDepth(Frame& frame, KeyFrame& keyframe, const Rigid3d& world_from_cam,
-                            size_t i);
+                            size_t i, double static_probability);
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
   void CorrectDepthScale(Frame& frame, bool inliers_only);
@@ -109,6 +133,10 @@ class Tracking {
   uint64_t last_reloc_frame_id_ = 0;
   int matches_inliers_ = 0;
   int lost_streak_ = 0;
+  int weak_streak_ = 0;        // consecutive weak poses (PoseQuality)
+  int judged_dynamic_ = 0;     // JudgeStaticness of the current frame
+  std::vector<uint8_t> in_dynamic_box_;  // the current frame's (Track's argument)
+  int geometric_culled_ = 0;
   int num_lost_ = 0;
   int num_relocalisations_ = 0;
   double last_depth_scale_ = 1.0;  // the last tracked frame's network scale correction

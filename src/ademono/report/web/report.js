@@ -424,7 +424,9 @@
       el('span', {}, swatch(COLORS.loop), 'loop closed'),
       el('span', {}, fmt(F.keyframe.reduce((a, b) => a + b, 0), 0) + ' keyframes, ' + fmt(F.relocalised.reduce((a, b) => a + b, 0), 0) + ' relocalisations, ' +
         fmt((F.loop || []).reduce((a, b) => a + b, 0), 0) + ' loops, ' +
-        fmt(F.state.filter((s) => s === 2).length, 0) + ' lost frames')));
+        fmt(F.state.filter((s) => s === 2).length, 0) + ' lost frames, ' +
+        fmt((F.weak || []).filter((w) => w === 1).length, 0) + ' weak poses on few static points, ' +
+        fmt((F.weak || []).filter((w) => w === 2).length, 0) + ' on the motion model alone')));
     const tl = el('div', { id: 'plot-timeline' });
     tlPanel.appendChild(tl);
     // Negative counts mean "not recorded": such series are left out.
@@ -433,7 +435,9 @@
       [F.kept, { label: 'kept by the filters', stroke: '#37b24d', width: 1 }],
       [F.with_depth, { label: 'with depth', stroke: '#9775fa', width: 1 }],
       [F.inliers, { label: 'inliers', stroke: COLORS.inliers, width: 1.5 }],
-    ].filter(([v]) => v.some((x) => x >= 0));
+      [F.static_points || [], { label: 'static points the pose rests on', stroke: '#0b7285', width: 1 }],
+      [F.geometric_dynamic || [], { label: 'matches judged moving (geometry)', stroke: '#e03131', width: 1 }],
+    ].filter(([v]) => v.length > 0 && v.some((x) => x >= 0));
     makePlot(tl, 200, timeOpts('Features and inliers per frame', 'points', counts.map(([, s]) => s), F, true),
       [F.t].concat(counts.map(([v]) => v)));
 

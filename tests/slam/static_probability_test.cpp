@@ -1,0 +1,96 @@
+// The geometric test for movers without a box (slam/static_probability.h): the verdict of one
+// observation, the Bayes update, and on the synthetic office with no boxes at all (the walking
+// persons are movers no detector reports) the map points on them are judged moving while the
+// static scene is kept.
+#include "ademono/slam/static_probability.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ademono/slam/system.h"
+#include "synthetic_sequence.h"
+
+namespace ademono {
+namespace {
+
+using testing_util::SyntheticOffice;
+
+TEST(StaticProbabilityTest, JudgesResidualAndDepth) {
+  const StaticTestParams p;
+  EXPECT_EQ(JudgeObservation(1.0, std::nullopt, p), StaticEvidence::kStatic);
+  EXPECT_EQ(JudgeObservation(1.0, 0.01, p), StaticEvidence::kStatic);
+  // Depth disagreement alone is motion (a walker coming towards the camera along the ray).
+  EXPECT_EQ(JudgeObservation(1.0, 0.3, p), StaticEvidence::kDynamic);
+  EXPECT_EQ(JudgeObservation(10.0, std::nullopt, p), StaticEvidence::kDynamic);
+  // Between the bands: no verdict.
+  EXPECT_EQ(JudgeObservation(4.0, 0.01, p), StaticEvidence::kNone);
+  EXPECT_EQ(JudgeObservation(1.0, 0.1, p), StaticEvidence::kNone);
+  // Behind the camera / no projection.
+  EXPECT_EQ(JudgeObservation(std::numeric_limits<double>::infinity(), std::nullopt, p),
+            StaticEvidence::kDynamic);
+}
+
+TEST(StaticProbabilityTest, MotionOutweighsAgreementAndStaysReversible) {
+  double p = 0.45;
+  p = UpdateStaticProbability(p, StaticEvidence::kStatic);
+  EXPECT_NEAR(p, 0.45 * 1.5 / (0.45 * 1.5 + 0.55), 1e-12);
+  EXPECT_GE(p, 0.5);  // one agreeing frame admits a new point
+  p = UpdateStaticProbability(p, StaticEvidence::kDynamic);
+  EXPECT_LT(p, 0.5);  // one moving frame removes it again
+  EXPECT_EQ(UpdateStaticProbability(0.3, StaticEvidence::kNone), 0.3);
+  // Clamped: a long history can still be overturned.
+  double high = 0.5;
+  for (int i = 0; i < 100; ++i) high = UpdateStaticProbability(high, StaticEvidence::kStatic);
+  EXPECT_DOUBLE_EQ(high, 0.98);
+  for (int i = 0; i < 4; ++i) high = UpdateStaticProbability(high, StaticEvidence::kDynamic);
+  EXPECT_LT(high, 0.5);
+}
+
+struct BoxlessRun {
+  double ate_rmse = 0;
+  int tracked = 0;
+  long long judged_dynamic = 0;
+};
+
+// The office with its walking persons, tracked with no detections at all.
+BoxlessRun TrackWithoutBoxes(const SyntheticOffice& sequence, bool static_test) {
+  SystemOptions options;
+  options.tracking.static_test = static_test;
+  System system(sequence.GetCamera(), options);
+  BoxlessRun run;
+  for (size_t i = 0; i < sequence.Size(); ++i) {
+    const FrameData frame = sequence.Load(i);
+    const TrackResult r = system.TrackFrame(frame, frame.depth, {});
+    run.tracked += r.tracked;
+    run.judged_dynamic += r.geometric_dynamic;
+  }
+  system.Shutdown();
+  const Rigid3d first_from_world = sequence.WorldFromCam(0).inverse();
+  double sum2 = 0;
+  const Trajectory trajectory = system.FrameTrajectory();
+  for (const StampedPose& p : trajectory) {
+    const size_t i = static_cast<size_t>(std::lround(p.timestamp * 30.0));
+    const Rigid3d gt = first_from_world * sequence.WorldFromCam(i);
+    sum2 += (gt.translation() - p.world_from_cam.translation()).squaredNorm();
+  }
+  run.ate_rmse = std::sqrt(sum2 / static_cast<double>(trajectory.size()));
+  return run;
+}
+
+// The geometric test catches the persons' points without a box. On this small office (3 persons
+// filling much of a 320x240 view) it does not yet rescue the trajectory: 98 mm with the test,
+// 89 mm without, 71 and 80 of 80 frames tracked (measured; on bonn-crowd-a it does, README).
+TEST(StaticProbabilityTest, BoxlessMoversAreJudgedMoving) {
+  const SyntheticOffice sequence(80, 320, 240, 7, 3);
+  const BoxlessRun on = TrackWithoutBoxes(sequence, true);
+  const BoxlessRun off = TrackWithoutBoxes(sequence, false);
+  RecordProperty("ate_on_mm", static_cast<int>(std::lround(on.ate_rmse * 1000)));
+  RecordProperty("ate_off_mm", static_cast<int>(std::lround(off.ate_rmse * 1000)));
+  EXPECT_GT(on.judged_dynamic, 0);  // the persons' points are caught without a box
+  EXPECT_EQ(off.judged_dynamic, 0);
+  EXPECT_GE(on.tracked, 60);
+}
+
+}  // namespace
+}  // namespace ademono
