@@ -21,7 +21,7 @@ void BackEnd::Shutdown() {
   local_mapping_.Shutdown();
 }
 
-void BackEnd::HandOff(size_t frame_index) { local_mapping_.HandOff(frame_index); }
+void BackEnd::HandOff() { local_mapping_.HandOff(frames_); }
 
 std::optional<Rigid3d> BackEnd::PredictNext() const {
   std::lock_guard<std::mutex> lock(map_.mutex);
@@ -89,8 +89,9 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   if (out.new_keyframe) {
     result.new_keyframe = true;
-    local_mapping_.InsertKeyFrame(out.new_keyframe, frame.index);
+    local_mapping_.InsertKeyFrame(out.new_keyframe, frames_);
   }
+  ++frames_;
   // The keyframes merged by this frame (at their hand-off), each once.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
   return result;
