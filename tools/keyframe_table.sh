@@ -22,6 +22,12 @@ variants=(
   "handoff0|mapping.handoff_frames=0"
   "handoff4|mapping.handoff_frames=4"
   "handoff8|mapping.handoff_frames=8"
+  "close150|mapping.handoff_frames=4 tracking.close_tracked_min=150"
+  "close120_red080|mapping.handoff_frames=4 tracking.close_tracked_min=120 mapping.redundant_ratio=0.8"
+  "red070|mapping.handoff_frames=4 mapping.redundant_ratio=0.7"
+  "close180_red080|mapping.handoff_frames=4 tracking.close_tracked_min=180 mapping.redundant_ratio=0.8"
+  "close200_red080|mapping.handoff_frames=4 tracking.close_tracked_min=200 mapping.redundant_ratio=0.8"
+  "close150_red085|mapping.handoff_frames=4 tracking.close_tracked_min=150 mapping.redundant_ratio=0.85"
 )
 for v in "${variants[@]}"; do
   name="${v%%|*}" sets="${v#*|}" args=()

@@ -83,7 +83,7 @@ void BackEnd::SaveMap(const std::filesystem::path& path) {
   SaveMapFile(path, data);
 }
 
-void BackEnd::HandOff(size_t frame_index) { local_mapping_.HandOff(frame_index); }
+void BackEnd::HandOff() { local_mapping_.HandOff(frames_); }
 
 std::optional<Rigid3d> BackEnd::PredictNext() const {
   std::lock_guard<std::mutex> lock(map_.mutex);
@@ -158,6 +158,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
     const auto& last = tracking_.LastFrame();
     if (out.tracked && last && last->cam_from_world) out.cam_from_world = *last->cam_from_world;
   }
+  ++frames_;
   // The keyframes merged by this frame (at their hand-off), each once.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
   return result;

@@ -46,7 +46,8 @@ class BackEnd {
 
   // Start of a frame's back end, before PredictNext and Track: merges local mapping's pending
   // keyframe when this frame is its hand-off frame (the fixed schedule, slam/local_mapping.h).
-  void HandOff(size_t frame_index);
+  // Frames are counted here (calls to Track), not by their input index, which may repeat or jump.
+  void HandOff();
   // Constant-velocity prediction of the next frame's pose (the dynamic filter's stage 2).
   std::optional<Rigid3d> PredictNext() const;
   // `frame`: its index, timestamp and image (map point colours); `depth` as System::TrackFrame.
@@ -93,6 +94,7 @@ class BackEnd {
   Tracking tracking_;
   // Colour of each map point's first observation (for map.ply), keyed by point id.
   std::map<uint64_t, cv::Vec3b> point_colors_;
+  size_t frames_ = 0;  // Track calls so far: the hand-off schedule's clock
   bool shut_down_ = false;
 };
 

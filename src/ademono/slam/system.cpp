@@ -22,7 +22,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
     throw std::invalid_argument("System::TrackFrame: depth must be CV_32FC1 at the image size");
   }
   ExtractedFrame extracted = front_end_.Extract(frame, depth);
-  back_end_.HandOff(frame.index);
+  back_end_.HandOff();
   const FilteredFrame filtered =
       front_end_.Filter(extracted, detections, back_end_.PredictNext());
   const BackEndResult back = back_end_.Track(frame, depth, filtered);
