@@ -22,7 +22,6 @@ const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
                                      {{"sparse_schur", BaLinearSolver::kSparseSchur},
                                       {"dense_schur", BaLinearSolver::kDenseSchur},
                                       {"iterative_schur", BaLinearSolver::kIterativeSchur}});
-  ;
   return table;
 }
 
@@ -30,7 +29,6 @@ void BundleAdjustmentOptions::Check() const { Table().CheckRanges(*this); }
 
 namespace {
 
-// Solves with the observations not flagged in `skip`; returns whether Ceres converged.
 std::mutex observer_mutex;
 std::function<void(const BundleAdjustmentProblem&)>& Observer() {
   static std::function<void(const BundleAdjustmentProblem&)> observer;
@@ -45,6 +43,7 @@ ceres::CostFunction* MakeCost(const BundleAdjustmentOptions& options,
       new internal::BaResidual<kDim>(intrinsics, image));
 }
 
+// Solves with the observations not flagged in `skip`; returns whether Ceres converged.
 bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
            const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
            std::vector<double>& points) {
