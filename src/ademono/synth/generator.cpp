@@ -118,6 +118,8 @@ nlohmann::ordered_json SceneJson(const Scene& scene, const GeneratorOptions& opt
   j["fps"] = scene.fps;
   j["noise_sigma"] = options.noise_sigma;
   j["blur_px"] = options.blur_px;
+  // Only with photos, so sequences without them keep their bytes.
+  if (!options.scene.actor_photos.empty()) j["actor_photos"] = options.scene.actor_photos;
   j["camera"] = {{"width", scene.camera.width}, {"height", scene.camera.height},
                  {"fx", scene.camera.fx},       {"fy", scene.camera.fy},
                  {"cx", scene.camera.cx},       {"cy", scene.camera.cy}};
@@ -126,11 +128,13 @@ nlohmann::ordered_json SceneJson(const Scene& scene, const GeneratorOptions& opt
   j["world_frame"] = "z up; groundtruth.txt poses are world_from_cam";
   nlohmann::ordered_json objects = nlohmann::ordered_json::array();
   for (const SceneObject& object : scene.objects) {
-    objects.push_back({{"id", object.id},
-                       {"name", object.name},
-                       {"class_id", object.class_id},
-                       {"class", object.class_name},
-                       {"moving", object.moving}});
+    nlohmann::ordered_json o = {{"id", object.id},
+                                {"name", object.name},
+                                {"class_id", object.class_id},
+                                {"class", object.class_name},
+                                {"moving", object.moving}};
+    if (!object.appearance.empty()) o["appearance"] = "photo " + object.appearance;
+    objects.push_back(o);
   }
   j["objects"] = objects;
   j["static_boxes"] = scene.static_boxes.size();
@@ -159,7 +163,8 @@ RenderedFrame RenderSceneFrame(const Scene& scene, size_t index, const Generator
   const double t = std::stod(FrameStamp(scene, index));
   const std::vector<Box> boxes = scene.BoxesAt(t);
   RenderedFrame frame =
-      RenderBoxes(scene.camera, scene.textures, boxes, scene.world_from_cam(t), scene.sky_bgr);
+      RenderBoxes(scene.camera, scene.textures, boxes, scene.world_from_cam(t), scene.sky_bgr,
+                  scene.sprites);
   if (options.blur_px > 0)
     ApplyMotionBlur(frame.image, MeanImageMotion(scene, frame.depth, t), options.blur_px);
   AddNoise(frame.image, options.noise_sigma, SubSeed(options.scene.seed, 0x401CE + index));
