@@ -2,6 +2,9 @@
 // against the sequence's ground-truth boxes (detections.jsonl, IoU >= --min-iou). The work is in
 // synth/detector_recall.h.
 #include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <spdlog/spdlog.h>
 
 #include "ademono/core/error.h"
@@ -56,7 +59,59 @@ int Recall(const RecallArgs& args) {
   }
   if (truth.size() != detected.size())
     ThrowInputError(truth_path, "has no entry for some frames of the sequence");
-  const synth::RecallResult result = synth::DetectorRecall(truth, detected, args.min_iou);
+  // With objects.jsonl (synth --actor-photos), each true box is labelled with its object:
+  // the box with the same extent among that frame's objects.
+  std::vector<std::vector<std::string>> labels;
+  const fs::path objects_path = fs::path(args.sequence) / "objects.jsonl";
+  const fs::path scene_path = fs::path(args.sequence) / "scene.json";
+  const bool labelled = fs::is_regular_file(objects_path) && fs::is_regular_file(scene_path);
+  if (labelled) {
+    std::map<int, std::string> names;
+    try {
+      const nlohmann::json scene = nlohmann::json::parse(ReadTextFile(scene_path));
+      for (const auto& o : scene.at("objects")) {
+        std::string label = o.at("name").get<std::string>() +
+                            (o.at("moving").get<bool>() ? " (moving" : " (static");
+        if (o.contains("appearance")) label += ", " + o.at("appearance").get<std::string>();
+        names[o.at("id").get<int>()] = label + ")";
+      }
+    } catch (const nlohmann::json::exception& e) {
+      ThrowInputError(scene_path, std::string("bad scene description: ") + e.what());
+    }
+    std::map<std::string, nlohmann::json> objects_by_frame;
+    std::istringstream lines(ReadTextFile(objects_path));
+    std::string line;
+    while (std::getline(lines, line)) {
+      if (line.empty()) continue;
+      try {
+        nlohmann::json j = nlohmann::json::parse(line);
+        objects_by_frame[j.at("name").get<std::string>()] = j.at("objects");
+      } catch (const nlohmann::json::exception& e) {
+        ThrowInputError(objects_path, std::string("bad line: ") + e.what());
+      }
+    }
+    for (const FrameDetections& t : truth) {
+      std::vector<std::string> frame_labels;
+      const auto it = objects_by_frame.find(t.name);
+      for (const Detection& d : t.detections) {
+        std::string label = "?";
+        if (it != objects_by_frame.end()) {
+          for (const auto& o : it->second) {
+            const auto& b = o.at("box_xywh");
+            if (b[0].get<float>() == d.box.x && b[1].get<float>() == d.box.y &&
+                b[2].get<float>() == d.box.width && b[3].get<float>() == d.box.height) {
+              label = names[o.at("id").get<int>()];
+              break;
+            }
+          }
+        }
+        frame_labels.push_back(label);
+      }
+      labels.push_back(std::move(frame_labels));
+    }
+  }
+  const synth::RecallResult result =
+      synth::DetectorRecall(truth, detected, args.min_iou, labelled ? &labels : nullptr);
   std::cout << result.Markdown();
   if (!args.json_out.empty()) WriteTextFileAtomic(args.json_out, result.ToJson().dump(1) + "\n");
   if (!args.save_detections.empty()) WriteDetectionsJsonl(args.save_detections, detected);

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <stdexcept>
 #include <tuple>
 #include <unordered_map>
 
 namespace ademono::synth {
+
+int RecallClass(int class_id) { return class_id == 5 || class_id == 7 ? 2 : class_id; }
 
 double BoxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
   const float inter = (a & b).area();
@@ -14,13 +17,19 @@ double BoxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
 }
 
 RecallResult DetectorRecall(const std::vector<FrameDetections>& truth,
-                            const std::vector<FrameDetections>& detected, double min_iou) {
+                            const std::vector<FrameDetections>& detected, double min_iou,
+                            const std::vector<std::vector<std::string>>* labels) {
+  if (labels && labels->size() != truth.size())
+    throw std::invalid_argument("recall: one label list per ground-truth frame expected");
   std::unordered_map<std::string, const FrameDetections*> by_name;
   for (const FrameDetections& f : detected) by_name.emplace(f.name, &f);
   RecallResult result;
   result.min_iou = min_iou;
-  for (const FrameDetections& t : truth) {
+  for (size_t f = 0; f < truth.size(); ++f) {
+    const FrameDetections& t = truth[f];
     ++result.frames;
+    if (labels && (*labels)[f].size() != t.detections.size())
+      throw std::invalid_argument("recall: one label per ground-truth box expected");
     const auto it = by_name.find(t.name);
     const std::vector<Detection> none;
     const std::vector<Detection>& dets = it == by_name.end() ? none : it->second->detections;
@@ -35,8 +44,13 @@ RecallResult DetectorRecall(const std::vector<FrameDetections>& truth,
       ClassRecall& c = result.classes[t.detections[i].class_id];
       c.class_name = t.detections[i].class_name;
       ++c.truth;
+      if (labels) {
+        ClassRecall& g = result.groups[(*labels)[f][i]];
+        g.class_name = c.class_name;
+        ++g.truth;
+      }
       for (size_t j = 0; j < dets.size(); ++j) {
-        if (dets[j].class_id != t.detections[i].class_id) continue;
+        if (RecallClass(dets[j].class_id) != RecallClass(t.detections[i].class_id)) continue;
         const double iou = BoxIou(t.detections[i].box, dets[j].box);
         if (iou >= min_iou) pairs.emplace_back(-iou, i, j);
       }
@@ -47,6 +61,7 @@ RecallResult DetectorRecall(const std::vector<FrameDetections>& truth,
       if (truth_used[i] || det_used[j]) continue;
       truth_used[i] = det_used[j] = true;
       ++result.classes[t.detections[i].class_id].found;
+      if (labels) ++result.groups[(*labels)[f][i]].found;
     }
   }
   return result;
@@ -70,6 +85,17 @@ nlohmann::ordered_json RecallResult::ToJson() const {
     found += c.found;
   }
   j["classes"] = classes_json;
+  if (!groups.empty()) {
+    nlohmann::ordered_json groups_json = nlohmann::ordered_json::array();
+    for (const auto& [label, g] : groups) {
+      groups_json.push_back({{"label", label},
+                             {"class", g.class_name},
+                             {"truth_boxes", g.truth},
+                             {"found", g.found},
+                             {"recall", g.Recall()}});
+    }
+    j["groups"] = groups_json;
+  }
   j["truth_boxes"] = truth;
   j["found"] = found;
   j["recall"] = truth > 0 ? nlohmann::ordered_json(static_cast<double>(found) / truth)
@@ -90,6 +116,12 @@ std::string RecallResult::Markdown() const {
   out += fmt::format("| all | {} | {} | {} | {} |\n", truth, found,
                      truth > 0 ? fmt::format("{:.3f}", static_cast<double>(found) / truth) : "-",
                      detected);
+  if (!groups.empty()) {
+    out += "\n| object | class | true boxes | found | recall |\n|---|---|---|---|---|\n";
+    for (const auto& [label, g] : groups)
+      out += fmt::format("| {} | {} | {} | {} | {:.3f} |\n", label, g.class_name, g.truth,
+                         g.found, g.Recall());
+  }
   return out;
 }
 

@@ -103,12 +103,10 @@ ActorPhotos LoadActorPhotos(const fs::path& dir) {
   } catch (const nlohmann::json::exception& e) {
     ThrowInputError(json_path, std::string("bad detection entry: ") + e.what());
   }
-  // Biggest first (most pixels for the nearest actors); ties by name for a fixed order.
+  // Surest first (a figure cut by the photo's border scores low); ties by name.
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) {
-                     const int ka = a.class_id == 0 ? a.box.height : a.box.area();
-                     const int kb = b.class_id == 0 ? b.box.height : b.box.area();
-                     if (ka != kb) return ka > kb;
+                     if (a.score != b.score) return a.score > b.score;
                      return std::tie(a.file, a.index) < std::tie(b.file, b.index);
                    });
   ActorPhotos photos;

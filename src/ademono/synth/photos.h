@@ -21,8 +21,8 @@ struct PhotoCutout {
 };
 
 struct ActorPhotos {
-  std::vector<PhotoCutout> persons;  // tallest source box first
-  std::vector<PhotoCutout> cars;     // largest source box first
+  std::vector<PhotoCutout> persons;  // highest reference score first
+  std::vector<PhotoCutout> cars;     // highest reference score first
 };
 
 // Reads `dir`/expected_detections.json and the photos it names. Persons need a score >= 0.5 and

@@ -330,7 +330,7 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     const PersonLook look = MakePersonLook(textures, rng, 1.0);
     if (photos) {
       // Quad across the sidewalk: the camera driving along the road sees the figure's front.
-      const PhotoCutout& cutout = photos->persons.back();
+      const PhotoCutout& cutout = photos->persons[3 % photos->persons.size()];
       const int sprite = AddSprite(scene, cutout, 1.75);
       scene.objects[id - 1].appearance = cutout.source;
       scene.actors.push_back(MakeWalkingSprite(path, M_PI / 2, sprite,
