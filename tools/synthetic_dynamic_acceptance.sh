@@ -65,15 +65,15 @@ def variants(path):
         return None
 def pct(a, b):
     return (100.0 * a / b, "%.1f%% (%d/%d)" % (100.0 * a / b, a, b)) if b else (None, "-")
-print("| scene | seed | YOLOX recall: persons / cars (photo movers) | ATE yolox | ATE gt boxes | ATE no removal | yolox/gt <= 1.5 | yolox/none <= 0.3 | moving removed >= 90% | of them unboxed, removed | static removed <= 10% | tracked |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+print("| scene | seed | YOLOX recall: persons / cars (photo movers) | ATE se3 yolox | ATE se3 gt boxes | ATE se3 no removal | yolox/gt <= 1.5 | yolox/none <= 0.3 | moving removed >= 90% | of them unboxed, removed | static removed <= 10% | tracked yolox / gt / none | ATE sim3 yolox / gt / none |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 ok_all = True
 for scene, seeds in (("office", office), ("street", street)):
     for seed in seeds:
         base = os.path.join(work, "%s_s%s" % (scene, seed))
         y, g = variants(base + "_yolox/ablation.json"), variants(base + "_gt/ablation.json")
         if not y or not g:
-            print("| %s | %s | missing results | | | | | | | | | |" % (scene, seed)); ok_all = False; continue
+            print("| %s | %s | missing results | | | | | | | | | | |" % (scene, seed)); ok_all = False; continue
         rec = json.load(open(base + "_recall.json"))
         def group_recall(cls):
             t = sum(x["truth_boxes"] for x in rec.get("groups", []) if x["class"] == cls and "photo" in x["label"])
@@ -94,10 +94,12 @@ for scene, seeds in (("office", office), ("street", street)):
         ok_all = ok_all and c1 and c2 and c3 and c4
         f = lambda v: "%.4f" % v if v is not None else "-"
         yes = lambda c, v: ("%.2f " % v if v is not None else "") + ("yes" if c else "**no**")
-        print("| %s | %s | %s / %s | %s | %s | %s | %s | %s | %s %s | %s | %s %s | %d/%d |" % (
+        print("| %s | %s | %s / %s | %s | %s | %s | %s | %s | %s %s | %s | %s %s | %d / %d / %d of %d | %s / %s / %s |" % (
             scene, seed, group_recall("person"), group_recall("car"), f(a), f(ag), f(an),
             yes(c1, r1), yes(c2, r2), mvs, "yes" if c3 else "**no**", ubs, sts,
-            "yes" if c4 else "**no**", full["tracked"], full["frames"]))
+            "yes" if c4 else "**no**", full["tracked"], gt["tracked"], nodyn["tracked"],
+            full["frames"], f(full["ate_sim3_rmse_m"]), f(gt["ate_sim3_rmse_m"]),
+            f(nodyn["ate_sim3_rmse_m"])))
 print()
 print("all criteria met" if ok_all else "NOT all criteria met")
 PY
