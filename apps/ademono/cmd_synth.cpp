@@ -22,6 +22,7 @@ struct SynthArgs {
   int persons = 2;
   double noise = 0.0;
   double blur = 0.0;
+  std::string actor_photos;  // empty: procedural actors
   std::string out;
 };
 
@@ -42,6 +43,7 @@ int RunSynth(const SynthArgs& args) {
   options.scene.persons = args.persons;
   options.noise_sigma = args.noise;
   options.blur_px = args.blur;
+  options.scene.actor_photos = args.actor_photos;
   const size_t every = std::max<size_t>(1, args.frames / 10);
   const auto summary =
       ademono::synth::GenerateSequence(options, args.out, [&](size_t done, size_t total) {
@@ -73,6 +75,12 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--noise", args->noise, "Gaussian image noise sigma, grey levels")
           ->capture_default_str();
       app.add_option("--blur", args->blur, "motion blur length in pixels")->capture_default_str();
+      app.add_option("--actor-photos", args->actor_photos,
+                     "photo-textured actors cut from the persons and cars of DIR (photos plus "
+                     "expected_detections.json; given without DIR: ../shared/images), and "
+                     "movers of no COCO class; off by default")
+          ->expected(0, 1)
+          ->default_str("../shared/images");
       app.add_option("--out", args->out, "output folder (must not exist or be empty)")->required();
       return [args] { return RunSynth(*args); };
     });

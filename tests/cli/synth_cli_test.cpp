@@ -102,6 +102,25 @@ TEST_F(SynthCliTest, BadOptionsFailWithOneLineAndNoOutput) {
   }
 }
 
+TEST_F(SynthCliTest, MissingActorPhotosFailWithOneLineAndNoOutput) {
+  const fs::path missing = dir_ / "no_photos";
+  const RunResult r = Run("--frames 1 --width 64 --height 48 --actor-photos " + missing.string() +
+                          " --out " + (dir_ / "out").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "ademono synth: error: " + missing.string() +
+                       ": actor photos folder not found (expected photos and "
+                       "expected_detections.json, e.g. ../shared/images)\n");
+  EXPECT_TRUE(Entries().empty());
+  // A folder without the detections file names the file.
+  fs::create_directories(missing);
+  const RunResult r2 = Run("--frames 1 --width 64 --height 48 --actor-photos " +
+                           missing.string() + " --out " + (dir_ / "out").string());
+  EXPECT_EQ(r2.exit_code, 2);
+  EXPECT_THAT(r2.err, HasSubstr("expected_detections.json"));
+  EXPECT_EQ(std::count(r2.err.begin(), r2.err.end(), '\n'), 1);
+  EXPECT_EQ(Entries(), (std::vector<std::string>{"no_photos"}));
+}
+
 TEST_F(SynthCliTest, RefusesNonEmptyOutputFolder) {
   fs::create_directories(dir_ / "out");
   std::ofstream(dir_ / "out" / "keep.txt") << "mine";

@@ -56,6 +56,16 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   // Static points in dynamic-class boxes: the static person's two and the parked car's two.
   EXPECT_EQ(counts.static_in_box_keypoints, 4);
   EXPECT_EQ(counts.static_in_box_removed, 2);
+  // Every judged keypoint off the mask is static (6), two of them removed; the moving ones are
+  // all inside the detector's person box, so none is unboxed.
+  EXPECT_EQ(counts.static_keypoints, 6);
+  EXPECT_EQ(counts.static_removed, 2);
+  EXPECT_EQ(counts.moving_unboxed_keypoints, 0);
+  // Without the moving person's box, its judged keypoints are movers the detector missed.
+  TruthCounts unboxed;
+  truth.Score(frame, {standing, parked, chair}, kps, labels, &unboxed);
+  EXPECT_EQ(unboxed.moving_unboxed_keypoints, 2);
+  EXPECT_EQ(unboxed.moving_unboxed_removed, 1);
 
   frame.name = "missing";
   EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);

@@ -20,6 +20,12 @@ nlohmann::json TruthCounts::ToJson() const {
           {"moving_removed", moving_removed},
           {"moving_kept", moving_kept},
           {"moving_removed_ratio", ratio(moving_removed, moving_keypoints)},
+          {"moving_unboxed_keypoints", moving_unboxed_keypoints},
+          {"moving_unboxed_removed", moving_unboxed_removed},
+          {"moving_unboxed_removed_ratio", ratio(moving_unboxed_removed, moving_unboxed_keypoints)},
+          {"static_keypoints", static_keypoints},
+          {"static_removed", static_removed},
+          {"static_removed_ratio", ratio(static_removed, static_keypoints)},
           {"static_person_keypoints", static_person_keypoints},
           {"static_person_removed", static_person_removed},
           {"static_person_removed_ratio", ratio(static_person_removed, static_person_keypoints)},
@@ -69,21 +75,26 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
     if (labels[i] == PointLabel::kEnhancementDropped) continue;
     const bool dynamic = IsDynamic(labels[i]);
+    const auto& classes = DefaultDynamicClassIds();
+    const bool in_box = std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
+      return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
+             d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
+    });
     if (mask.at<uint8_t>(p) > 127) {
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;
       if (labels[i] == PointLabel::kKept) ++counts->moving_kept;
+      if (!in_box) {
+        ++counts->moving_unboxed_keypoints;
+        if (dynamic) ++counts->moving_unboxed_removed;
+      }
     } else {
+      ++counts->static_keypoints;
+      if (dynamic) ++counts->static_removed;
       if (static_box && static_box->contains(p)) {
         ++counts->static_person_keypoints;
         if (dynamic) ++counts->static_person_removed;
       }
-      const auto& classes = DefaultDynamicClassIds();
-      const bool in_box =
-          std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
-            return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
-                   d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
-          });
       if (in_box) {
         ++counts->static_in_box_keypoints;
         if (dynamic) ++counts->static_in_box_removed;

@@ -21,6 +21,13 @@ struct TruthCounts {
   long long moving_keypoints = 0;         // keypoints whose pixel is in the moving-object mask
   long long moving_removed = 0;           // ... labelled dynamic
   long long moving_kept = 0;              // ... labelled kept (used for tracking)
+  // Moving keypoints outside every box of a dynamic class: movers the detector did not box
+  // (synth's movers of no COCO class, missed persons and cars). Removing them takes geometry.
+  long long moving_unboxed_keypoints = 0;
+  long long moving_unboxed_removed = 0;  // ... labelled dynamic
+  // Every keypoint not on a moving object (the static scene, boxed or not).
+  long long static_keypoints = 0;
+  long long static_removed = 0;  // ... labelled dynamic
   long long static_person_keypoints = 0;  // in the static person box, not on a moving object
   long long static_person_removed = 0;    // ... labelled dynamic
   // In any box of a dynamic class (the detector's box, not grown) but not on a moving object:

@@ -136,4 +136,30 @@ ActorFunction MakeRidingCyclist(const Rigid3d& world_from_body_at_0, double spee
   };
 }
 
+void AppendSprite(const Rigid3d& world_from_body, double yaw, int sprite, double width_m,
+                  double height_m, int object_id, std::vector<Box>& boxes) {
+  Rigid3d body_from_quad = Translation(0, 0, height_m / 2);
+  body_from_quad.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  // A thin box only bounds the quad for culling; the renderer intersects the plane y = 0.
+  Box box = MakeBox(world_from_body * body_from_quad, {width_m / 2, 0.005, height_m / 2}, 0,
+                    object_id);
+  box.sprite = sprite;
+  boxes.push_back(box);
+}
+
+ActorFunction MakeWalkingSprite(const BackAndForthPath& path, double yaw, int sprite,
+                                double width_m, double height_m, int object_id) {
+  return [=](double t, std::vector<Box>& boxes) {
+    AppendSprite(path.WorldFromBody(t, nullptr), yaw, sprite, width_m, height_m, object_id, boxes);
+  };
+}
+
+ActorFunction MakeDrivingSprite(const Rigid3d& world_from_body_at_0, double speed, double yaw,
+                                int sprite, double width_m, double height_m, int object_id) {
+  return [=](double t, std::vector<Box>& boxes) {
+    AppendSprite(world_from_body_at_0 * Translation(speed * t, 0, 0), yaw, sprite, width_m,
+                 height_m, object_id, boxes);
+  };
+}
+
 }  // namespace ademono::synth

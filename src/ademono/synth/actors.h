@@ -49,4 +49,13 @@ ActorFunction MakeRidingCyclist(const Rigid3d& world_from_body_at_0, double spee
                                 const CarLook& bike_look, const PersonLook& rider_look, int bike_id,
                                 int rider_id);
 
+// A photo sprite (Scene::sprites[sprite], width_m x height_m) standing on the ground at
+// `world_from_body`: its quad is the body's x-z plane turned by `yaw` about the body's z axis.
+void AppendSprite(const Rigid3d& world_from_body, double yaw, int sprite, double width_m,
+                  double height_m, int object_id, std::vector<Box>& boxes);
+ActorFunction MakeWalkingSprite(const BackAndForthPath& path, double yaw, int sprite,
+                                double width_m, double height_m, int object_id);
+ActorFunction MakeDrivingSprite(const Rigid3d& world_from_body_at_0, double speed, double yaw,
+                                int sprite, double width_m, double height_m, int object_id);
+
 }  // namespace ademono::synth

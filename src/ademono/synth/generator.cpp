@@ -118,6 +118,8 @@ nlohmann::ordered_json SceneJson(const Scene& scene, const GeneratorOptions& opt
   j["fps"] = scene.fps;
   j["noise_sigma"] = options.noise_sigma;
   j["blur_px"] = options.blur_px;
+  // Only with photos, so sequences without them keep their bytes.
+  if (!options.scene.actor_photos.empty()) j["actor_photos"] = options.scene.actor_photos;
   j["camera"] = {{"width", scene.camera.width}, {"height", scene.camera.height},
                  {"fx", scene.camera.fx},       {"fy", scene.camera.fy},
                  {"cx", scene.camera.cx},       {"cy", scene.camera.cy}};
@@ -126,11 +128,13 @@ nlohmann::ordered_json SceneJson(const Scene& scene, const GeneratorOptions& opt
   j["world_frame"] = "z up; groundtruth.txt poses are world_from_cam";
   nlohmann::ordered_json objects = nlohmann::ordered_json::array();
   for (const SceneObject& object : scene.objects) {
-    objects.push_back({{"id", object.id},
-                       {"name", object.name},
-                       {"class_id", object.class_id},
-                       {"class", object.class_name},
-                       {"moving", object.moving}});
+    nlohmann::ordered_json o = {{"id", object.id},
+                                {"name", object.name},
+                                {"class_id", object.class_id},
+                                {"class", object.class_name},
+                                {"moving", object.moving}};
+    if (!object.appearance.empty()) o["appearance"] = "photo " + object.appearance;
+    objects.push_back(o);
   }
   j["objects"] = objects;
   j["static_boxes"] = scene.static_boxes.size();
@@ -159,36 +163,55 @@ RenderedFrame RenderSceneFrame(const Scene& scene, size_t index, const Generator
   const double t = std::stod(FrameStamp(scene, index));
   const std::vector<Box> boxes = scene.BoxesAt(t);
   RenderedFrame frame =
-      RenderBoxes(scene.camera, scene.textures, boxes, scene.world_from_cam(t), scene.sky_bgr);
+      RenderBoxes(scene.camera, scene.textures, boxes, scene.world_from_cam(t), scene.sky_bgr,
+                  scene.sprites);
   if (options.blur_px > 0)
     ApplyMotionBlur(frame.image, MeanImageMotion(scene, frame.depth, t), options.blur_px);
   AddNoise(frame.image, options.noise_sigma, SubSeed(options.scene.seed, 0x401CE + index));
   return frame;
 }
 
-std::vector<Detection> BoxesFromObjectIds(const Scene& scene, const cv::Mat& object_id,
-                                          int min_box_pixels) {
-  struct Extent {
-    int umin = INT32_MAX, vmin = INT32_MAX, umax = -1, vmax = -1;
-    int pixels = 0;
-  };
-  std::vector<Extent> extents(scene.objects.size());
+std::vector<ObjectExtent> ObjectExtents(const Scene& scene, const cv::Mat& object_id) {
+  std::vector<ObjectExtent> extents(scene.objects.size());
   for (int v = 0; v < object_id.rows; ++v) {
     const int32_t* row = object_id.ptr<int32_t>(v);
     for (int u = 0; u < object_id.cols; ++u) {
       const int id = row[u];
       if (id < 1 || id > static_cast<int>(extents.size())) continue;
-      Extent& e = extents[id - 1];
+      ObjectExtent& e = extents[id - 1];
       e.umin = std::min(e.umin, u), e.umax = std::max(e.umax, u);
       e.vmin = std::min(e.vmin, v), e.vmax = std::max(e.vmax, v);
       ++e.pixels;
     }
   }
+  return extents;
+}
+
+std::string ObjectsJsonLine(const Scene& scene, size_t index, const cv::Mat& object_id) {
+  const std::vector<ObjectExtent> extents = ObjectExtents(scene, object_id);
+  nlohmann::ordered_json line;
+  line["frame"] = index;
+  line["name"] = FrameStamp(scene, index);
+  nlohmann::ordered_json objects = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < extents.size(); ++i) {
+    const ObjectExtent& e = extents[i];
+    if (e.pixels == 0) continue;
+    objects.push_back({{"id", scene.objects[i].id},
+                       {"box_xywh", {e.umin, e.vmin, e.umax - e.umin + 1, e.vmax - e.vmin + 1}},
+                       {"pixels", e.pixels}});
+  }
+  line["objects"] = objects;
+  return line.dump() + "\n";
+}
+
+std::vector<Detection> BoxesFromObjectIds(const Scene& scene, const cv::Mat& object_id,
+                                          int min_box_pixels) {
+  const std::vector<ObjectExtent> extents = ObjectExtents(scene, object_id);
   const std::vector<int>& dynamic = DefaultDynamicClassIds();
   std::vector<Detection> detections;
   for (size_t i = 0; i < extents.size(); ++i) {
     const SceneObject& object = scene.objects[i];
-    const Extent& e = extents[i];
+    const ObjectExtent& e = extents[i];
     if (e.pixels < min_box_pixels) continue;
     if (std::find(dynamic.begin(), dynamic.end(), object.class_id) == dynamic.end()) continue;
     Detection d;
@@ -271,6 +294,8 @@ GeneratorSummary GenerateSequenceInto(const GeneratorOptions& options, const fs:
       "# depth maps\n# file: 'ademono synth " + scene.name + "'\n# timestamp filename\n";
   Trajectory groundtruth;
   std::vector<FrameDetections> detections;
+  const bool object_truth = !options.scene.actor_photos.empty();
+  std::string objects_jsonl;
   double moving_fraction_sum = 0.0;
   for (size_t i = 0; i < options.scene.frames; ++i) {
     const auto render_start = std::chrono::steady_clock::now();
@@ -283,6 +308,7 @@ GeneratorSummary GenerateSequenceInto(const GeneratorOptions& options, const fs:
     frame_detections.name = stamp;
     frame_detections.detections =
         BoxesFromObjectIds(scene, frame.object_id, options.min_box_pixels);
+    if (object_truth) objects_jsonl += ObjectsJsonLine(scene, i, frame.object_id);
     summary.seconds_rendering +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
     summary.detections += frame_detections.detections.size();
@@ -304,6 +330,7 @@ GeneratorSummary GenerateSequenceInto(const GeneratorOptions& options, const fs:
   WriteTumTrajectory(tmp / "groundtruth.txt", groundtruth);
   WriteCameraYaml(tmp / "camera.yaml", scene.camera);
   WriteDetectionsJsonl(tmp / "detections.jsonl", detections);
+  if (object_truth) WriteTextFileAtomic(tmp / "objects.jsonl", objects_jsonl);
   WriteTextFileAtomic(tmp / "scene.json", SceneJson(scene, options, motion).dump(1) + "\n");
 
   if (fs::exists(out, ec)) fs::remove(out, ec);  // an empty folder (checked above)

@@ -14,6 +14,8 @@
 //                                   pixels; objects with fewer than `min_box_pixels` visible
 //                                   pixels get no box
 //   scene.json                      options, camera, objects (id, name, class, moving)
+//   objects.jsonl                   with actor photos only: per frame, the visible pixels' box
+//                                   and pixel count of every object (any class), by id
 // Everything is written into a temporary folder beside DIR and renamed onto DIR at the end, so a
 // failed run leaves nothing. Same options give byte-identical files (no global random state;
 // independent of the thread count).
@@ -55,6 +57,15 @@ RenderedFrame RenderSceneFrame(const Scene& scene, size_t index, const Generator
 // Ground-truth boxes of the dynamic-class objects visible in `object_id` (CV_32SC1).
 std::vector<Detection> BoxesFromObjectIds(const Scene& scene, const cv::Mat& object_id,
                                           int min_box_pixels);
+// Per object (index id - 1): the tight pixel extent of its visible pixels and their count.
+struct ObjectExtent {
+  int umin = INT32_MAX, vmin = INT32_MAX, umax = -1, vmax = -1;
+  int pixels = 0;
+};
+std::vector<ObjectExtent> ObjectExtents(const Scene& scene, const cv::Mat& object_id);
+// One objects.jsonl line (written with actor photos): every object with >= 1 visible pixel,
+// {"frame", "name", "objects": [{"id", "box_xywh", "pixels"}]}, in id order.
+std::string ObjectsJsonLine(const Scene& scene, size_t index, const cv::Mat& object_id);
 // 255 where a moving object is visible.
 cv::Mat MovingMask(const Scene& scene, const cv::Mat& object_id);
 // Depth in metres to TUM 16-bit PNG units (0 beyond the range).

@@ -20,6 +20,7 @@ struct PreparedBox {
   Eigen::Vector3d half;
   std::array<float, 6> shade;  // Lambert-like factor per face for the face normal seen
   const Box* box = nullptr;
+  const Sprite* sprite = nullptr;        // photo quad (Box::sprite), else a solid/room box
   double min_depth = 0.0;                // lower bound of the depth of any point of the box
   int u0 = 0, u1 = -1, v0 = 0, v1 = -1;  // pixel bounds (inclusive) where the box can appear
 };
@@ -100,6 +101,21 @@ struct Hit {
 // Ray origin + t * dir against the box slabs; updates `hit` when nearer. t is the camera depth
 // because the ray direction has z = 1 in the camera frame.
 inline void Intersect(const PreparedBox& p, const Eigen::Vector3d& dir, Hit& hit) {
+  if (p.sprite) {
+    // The quad y = 0 of the box frame; transparent texels let the ray through.
+    if (dir.y() == 0.0) return;
+    const double t = -p.origin.y() / dir.y();
+    if (!(t > 0.0) || t >= hit.depth) return;
+    const Eigen::Vector3d point = p.origin + t * dir;
+    if (std::abs(point.x()) > p.half.x() || std::abs(point.z()) > p.half.z()) return;
+    if (!p.sprite->Opaque(point.x() + p.half.x(), p.half.z() - point.z())) return;
+    hit.depth = t;
+    hit.box = &p;
+    hit.face = dir.y() > 0 ? 2 : 3;
+    hit.ray_box = dir;
+    hit.point_box = point;
+    return;
+  }
   double t_enter = -std::numeric_limits<double>::infinity();
   double t_exit = std::numeric_limits<double>::infinity();
   int enter_axis = 0, exit_axis = 0;
@@ -135,7 +151,7 @@ inline void Intersect(const PreparedBox& p, const Eigen::Vector3d& dir, Hit& hit
 
 RenderedFrame RenderBoxes(const Camera& camera, const std::vector<Texture>& textures,
                           const std::vector<Box>& boxes, const Rigid3d& world_from_cam,
-                          const cv::Vec3f& sky_bgr) {
+                          const cv::Vec3f& sky_bgr, const std::vector<Sprite>& sprites) {
   if (camera.HasDistortion())
     throw std::invalid_argument("synthetic rendering needs an undistorted camera");
   camera.Check();
@@ -144,11 +160,14 @@ RenderedFrame RenderBoxes(const Camera& camera, const std::vector<Texture>& text
       if (t < 0 || t >= static_cast<int>(textures.size()))
         throw std::invalid_argument("box refers to a missing texture");
     }
+    if (box.sprite >= static_cast<int>(sprites.size()))
+      throw std::invalid_argument("box refers to a missing sprite");
   }
   std::vector<PreparedBox> prepared;
   prepared.reserve(boxes.size());
   for (const Box& box : boxes) {
     PreparedBox p = Prepare(box, camera, world_from_cam);
+    if (box.sprite >= 0) p.sprite = &sprites[box.sprite];
     if (p.v1 >= p.v0) prepared.push_back(p);
   }
   // Nearest first, so a pixel stops testing once its hit is closer than the next box can be.
@@ -203,9 +222,11 @@ RenderedFrame RenderBoxes(const Camera& camera, const std::vector<Texture>& text
         const double cos_incidence =
             std::max(0.25, std::abs(hit.ray_box[axis]) / std::sqrt(ray_norm2));
         const double footprint = hit.depth * std::sqrt(ray_norm2) / (mean_focal * cos_incidence);
-        const Texture& texture = textures[hit.box->box->face_texture[hit.face]];
         const cv::Vec3f colour =
-            texture.Sample(face_u, face_v, footprint) * hit.box->shade[hit.face];
+            hit.box->sprite
+                ? hit.box->sprite->Sample(face_u, face_v, footprint)
+                : textures[hit.box->box->face_texture[hit.face]].Sample(face_u, face_v, footprint) *
+                      hit.box->shade[hit.face];
         image_row[u] =
             cv::Vec3b(cv::saturate_cast<uint8_t>(colour[0]), cv::saturate_cast<uint8_t>(colour[1]),
                       cv::saturate_cast<uint8_t>(colour[2]));

@@ -21,9 +21,10 @@ struct RenderedFrame {
 };
 
 // Renders `boxes` with the scene's textures seen from `world_from_cam`. The camera must have no
-// distortion (std::invalid_argument otherwise).
+// distortion (std::invalid_argument otherwise). Boxes with `sprite >= 0` are photo quads drawn
+// from `sprites` (unshaded: the photo carries its own light).
 RenderedFrame RenderBoxes(const Camera& camera, const std::vector<Texture>& textures,
                           const std::vector<Box>& boxes, const Rigid3d& world_from_cam,
-                          const cv::Vec3f& sky_bgr);
+                          const cv::Vec3f& sky_bgr, const std::vector<Sprite>& sprites = {});
 
 }  // namespace ademono::synth

@@ -20,7 +20,7 @@ int Scene::AddObject(const std::string& object_name, int class_id, bool moving) 
   object.id = static_cast<int>(objects.size()) + 1;
   object.name = object_name;
   object.class_id = class_id;
-  object.class_name = CocoClassNames().at(class_id);
+  object.class_name = class_id < 0 ? "none" : CocoClassNames().at(class_id);
   object.moving = moving;
   objects.push_back(object);
   return object.id;

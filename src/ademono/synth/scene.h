@@ -15,6 +15,7 @@
 
 #include "ademono/core/camera.h"
 #include "ademono/core/geometry.h"
+#include "ademono/synth/sprite.h"
 #include "ademono/synth/texture.h"
 
 namespace ademono::synth {
@@ -27,6 +28,9 @@ struct Box {
   int object_id = 0;
   // Seen from inside (a room): the surface is where the ray leaves the box.
   bool inside = false;
+  // >= 0: not a box but the photo sprite Scene::sprites[sprite] on the quad through the centre
+  // spanning the box's x and z axes (synth/sprite.h); face_texture is then unused.
+  int sprite = -1;
 };
 
 struct SceneObject {
@@ -35,6 +39,7 @@ struct SceneObject {
   int class_id = -1;       // COCO class id
   std::string class_name;  // COCO class name
   bool moving = false;     // true when the object moves during the sequence
+  std::string appearance;  // empty: procedural boxes; else the photo it is cut from
 };
 
 // Appends the boxes of one animated actor at time t (seconds) to `boxes`.
@@ -45,6 +50,7 @@ struct Scene {
   Camera camera;
   double fps = 30.0;
   std::vector<Texture> textures;
+  std::vector<Sprite> sprites;  // photo cut-outs (only with actor photos)
   std::vector<Box> static_boxes;
   std::vector<SceneObject> objects;  // objects[i].id == i + 1
   std::vector<ActorFunction> actors;
@@ -57,7 +63,8 @@ struct Scene {
 
   // Adds a texture and returns its index.
   int AddTexture(const TextureSpec& spec);
-  // Adds an object and returns its id.
+  // Adds an object and returns its id. class_id -1: no COCO class (a mover no detector should
+  // name; it is in the moving masks but never in detections.jsonl).
   int AddObject(const std::string& name, int class_id, bool moving);
 };
 

@@ -1,9 +1,11 @@
 #include "ademono/synth/scenes.h"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "ademono/synth/actors.h"
+#include "ademono/synth/photos.h"
 #include "ademono/synth/random.h"
 
 namespace ademono::synth {
@@ -76,7 +78,27 @@ double LoopPeriod(const SceneOptions& options, double fps) {
   return 0.85 * static_cast<double>(options.frames) / fps;
 }
 
-void BuildOffice(const SceneOptions& options, Scene& scene) {
+// Adds a sprite cut from `cutout`, `height_m` tall; returns its index.
+int AddSprite(Scene& scene, const PhotoCutout& cutout, double height_m) {
+  scene.sprites.push_back(Sprite::FromCutout(cutout.bgr, cutout.alpha, height_m));
+  return static_cast<int>(scene.sprites.size()) - 1;
+}
+
+// A box of no COCO class carried along `path` (ground z = 0 at `height_m` above it) and
+// turning about `axis` at `spin` rad/s: a mover no detector has a name for.
+ActorFunction MakeTumblingBox(const BackAndForthPath& path, double height_m,
+                              const Eigen::Vector3d& half, const Eigen::Vector3d& axis,
+                              double spin, int texture, int object_id) {
+  return [=](double t, std::vector<Box>& boxes) {
+    Rigid3d pose = path.WorldFromBody(t, nullptr);
+    pose.translation().z() += height_m;
+    if (spin != 0.0) pose.linear() = pose.linear() *
+                                     Eigen::AngleAxisd(spin * t, axis.normalized()).toRotationMatrix();
+    boxes.push_back(MakeBox(pose, half, texture, object_id));
+  };
+}
+
+void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& scene) {
   Rng rng(SubSeed(options.seed, 0x0FF1CE));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E87));
   scene.fps = 30.0;
@@ -139,7 +161,42 @@ void BuildOffice(const SceneOptions& options, Scene& scene) {
     path.offset_m = rng.Uniform(0, 10.0);
     const PersonLook look = MakePersonLook(textures, rng, rng.Uniform(0.93, 1.05));
     const int id = scene.AddObject("person-" + std::to_string(i + 1), 0, true);
-    scene.actors.push_back(MakeWalkingPerson(path, look, id));
+    if (photos) {
+      // The photo person on the walker's path, its quad along the walking direction (seen
+      // from the front by the camera looking across the paths).
+      const PhotoCutout& cutout = photos->persons[i % photos->persons.size()];
+      const int sprite = AddSprite(scene, cutout, 1.75 * look.scale);
+      scene.objects[id - 1].appearance = cutout.source;
+      scene.actors.push_back(MakeWalkingSprite(path, 0.0, sprite, scene.sprites[sprite].width_m(),
+                                               scene.sprites[sprite].height_m(), id));
+    } else {
+      scene.actors.push_back(MakeWalkingPerson(path, look, id));
+    }
+  }
+  if (photos) {
+    // Movers of no COCO class, drawn from their own streams (the rest of the scene unchanged).
+    Rng decoy(SubSeed(options.seed, 0xDEC0));
+    TextureMaker decoy_textures(scene, SubSeed(options.seed, 0xDEC1));
+    BackAndForthPath cart_path;
+    cart_path.a = {-2.3, -0.1, 0};
+    cart_path.b = {2.3, -0.1 + decoy.Uniform(-0.2, 0.2), 0};
+    cart_path.speed = decoy.Uniform(0.5, 0.8);
+    cart_path.offset_m = decoy.Uniform(0, 9.0);
+    const Eigen::Vector3d cart_half(0.3, 0.22, 0.35);
+    const int cart = scene.AddObject("cart", -1, true);
+    scene.actors.push_back(MakeTumblingBox(
+        cart_path, cart_half.z(), cart_half, Eigen::Vector3d::UnitZ(), 0.0,
+        decoy_textures.ForBox(TextureStyle::kCarPaint, cart_half, 0.003, RandomTint(decoy)), cart));
+    BackAndForthPath cube_path;
+    cube_path.a = {-2.0, 0.5, 0};
+    cube_path.b = {2.0, 0.5 + decoy.Uniform(-0.3, 0.3), 0};
+    cube_path.speed = decoy.Uniform(0.4, 0.7);
+    cube_path.offset_m = decoy.Uniform(0, 8.0);
+    const Eigen::Vector3d cube_half(0.17, 0.17, 0.17);
+    const int cube = scene.AddObject("tumbling-cube", -1, true);
+    scene.actors.push_back(MakeTumblingBox(
+        cube_path, 1.3, cube_half, Eigen::Vector3d(1.0, 0.6, 0.3), 1.5,
+        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.003, RandomTint(decoy)), cube));
   }
 
   MotionSpec motion;
@@ -159,7 +216,7 @@ void BuildOffice(const SceneOptions& options, Scene& scene) {
   scene.world_from_cam = MakeCameraTrajectory(motion);
 }
 
-void BuildStreet(const SceneOptions& options, Scene& scene) {
+void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& scene) {
   Rng rng(SubSeed(options.seed, 0x57EE7));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E88));
   scene.fps = 10.0;
@@ -240,11 +297,25 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
                 scene.static_boxes);
     }
   }
+  // With photos, moving cars are photo cut-outs 1.5 m tall whose quad spans the road (seen
+  // from behind or ahead); the draws for the box car are made anyway, so the rest of the scene
+  // does not change.
+  int photo_cars = 0;
+  auto driving_car = [&](const Rigid3d& world_from_body_at_0, double car_speed,
+                         const CarLook& look, int id) {
+    if (!photos) return MakeDrivingCar(world_from_body_at_0, car_speed, look, id);
+    const PhotoCutout& cutout = photos->cars[photo_cars++ % photos->cars.size()];
+    const int sprite = AddSprite(scene, cutout, 1.5);
+    scene.objects[id - 1].appearance = cutout.source;
+    return MakeDrivingSprite(world_from_body_at_0, car_speed, M_PI / 2, sprite,
+                             scene.sprites[sprite].width_m(), scene.sprites[sprite].height_m(), id);
+  };
   // Moving cars: one leading in the camera's lane, oncoming ones passing at spread-out times.
   {
     const int id = scene.AddObject("car-lead", 2, true);
-    scene.actors.push_back(MakeDrivingCar(At(rng.Uniform(15, 22), -1.75, 0),
-                                          speed * rng.Uniform(0.9, 1.05), car_look(), id));
+    // Same argument expressions as the box car had: the draws keep their (compiler's) order.
+    scene.actors.push_back(driving_car(At(rng.Uniform(15, 22), -1.75, 0),
+                                       speed * rng.Uniform(0.9, 1.05), car_look(), id));
   }
   const int oncoming = 2 + static_cast<int>(rng.Next() % 2);
   for (int i = 0; i < oncoming; ++i) {
@@ -253,7 +324,7 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
     // Passing the camera (x = speed * pass_time) at pass_time.
     const double x0 = speed * pass_time + car_speed * pass_time;
     const int id = scene.AddObject("car-oncoming-" + std::to_string(i + 1), 2, true);
-    scene.actors.push_back(MakeDrivingCar(At(x0, 1.75, 0, M_PI), car_speed, car_look(), id));
+    scene.actors.push_back(driving_car(At(x0, 1.75, 0, M_PI), car_speed, car_look(), id));
   }
   // Cyclists in the bike lane, overtaken by the camera.
   for (int i = 0; i < 2; ++i) {
@@ -272,7 +343,42 @@ void BuildStreet(const SceneOptions& options, Scene& scene) {
     path.b = {60, -9.0, 0};
     path.speed = 1.3;
     const int id = scene.AddObject("pedestrian", 0, true);
-    scene.actors.push_back(MakeWalkingPerson(path, MakePersonLook(textures, rng, 1.0), id));
+    const PersonLook look = MakePersonLook(textures, rng, 1.0);
+    if (photos) {
+      // Quad across the sidewalk: the camera driving along the road sees the figure's front.
+      const PhotoCutout& cutout = photos->persons[3 % photos->persons.size()];
+      const int sprite = AddSprite(scene, cutout, 1.75);
+      scene.objects[id - 1].appearance = cutout.source;
+      scene.actors.push_back(MakeWalkingSprite(path, M_PI / 2, sprite,
+                                               scene.sprites[sprite].width_m(),
+                                               scene.sprites[sprite].height_m(), id));
+    } else {
+      scene.actors.push_back(MakeWalkingPerson(path, look, id));
+    }
+  }
+  if (photos) {
+    // Movers of no COCO class: a crate wheeled along the left sidewalk towards the camera, and
+    // a cube tumbling along the right bike lane.
+    Rng decoy(SubSeed(options.seed, 0xDEC2));
+    TextureMaker decoy_textures(scene, SubSeed(options.seed, 0xDEC3));
+    BackAndForthPath crate_path;
+    crate_path.a = {decoy.Uniform(40, 60), 8.3, 0};
+    crate_path.b = {-30, 8.3, 0};
+    crate_path.speed = decoy.Uniform(1.2, 1.8);
+    const Eigen::Vector3d crate_half(0.45, 0.4, 0.55);
+    const int crate = scene.AddObject("crate", -1, true);
+    scene.actors.push_back(MakeTumblingBox(
+        crate_path, crate_half.z(), crate_half, Eigen::Vector3d::UnitZ(), 0.0,
+        decoy_textures.ForBox(TextureStyle::kWood, crate_half, 0.01, RandomTint(decoy)), crate));
+    BackAndForthPath cube_path;
+    cube_path.a = {decoy.Uniform(20, 35), -4.3, 0};
+    cube_path.b = {cube_path.a.x() + 400.0, -4.3, 0};
+    cube_path.speed = decoy.Uniform(2.5, 4.0);
+    const Eigen::Vector3d cube_half(0.4, 0.4, 0.4);
+    const int cube = scene.AddObject("tumbling-cube", -1, true);
+    scene.actors.push_back(MakeTumblingBox(
+        cube_path, 0.7, cube_half, Eigen::Vector3d(0.2, 1.0, 0.1), 2.0,
+        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.01, RandomTint(decoy)), cube));
   }
 
   MotionSpec motion;
@@ -401,12 +507,15 @@ Scene BuildScene(const SceneOptions& options) {
   options.Check();
   Scene scene;
   scene.name = options.scene;
+  std::optional<ActorPhotos> photos;
+  if (!options.actor_photos.empty()) photos = LoadActorPhotos(options.actor_photos);
+  const ActorPhotos* photos_ptr = photos ? &*photos : nullptr;
   if (options.scene == "office") {
-    BuildOffice(options, scene);
+    BuildOffice(options, photos_ptr, scene);
   } else if (options.motion == MotionKind::kLoop) {
     BuildStreetLoop(options, scene);
   } else {
-    BuildStreet(options, scene);
+    BuildStreet(options, photos_ptr, scene);
   }
   return scene;
 }

@@ -25,6 +25,12 @@ struct SceneOptions {
   uint64_t seed = 0;
   int width = 0, height = 0;  // 0: the scene's default; intrinsics scale with the size
   int persons = 2;            // office: walking persons (1..3)
+  // Folder of actor photos (synth/photos.h), empty: procedural actors only. With photos the
+  // walking persons, the street's moving cars and its pedestrian are photo cut-outs, and each
+  // scene gains movers of no COCO class (a cart and a tumbling cube in the office, a crate and
+  // a tumbling cube in the street) that a detector should not box. Without, the scene is the
+  // same as before the option existed (byte-identical outputs).
+  std::string actor_photos;
   // Throws std::invalid_argument naming the first bad field.
   void Check() const;
 };

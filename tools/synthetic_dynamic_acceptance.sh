@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# Acceptance of dynamic removal on synthetic office and street sequences with photo-textured
+# actors (issue 17; docs/synth.md "Actor photos"): three seeds each, simulated network depth,
+# YOLOX-nano as the detector, compared with ground-truth boxes and with no dynamic removal.
+# Usage: tools/synthetic_dynamic_acceptance.sh [ADEMONO_BINARY] [WORK_DIR] [-- extra ablate args]
+#   OFFICE_SEEDS (7 5 11), STREET_SEEDS (1 2 3), OFFICE_FRAMES (300), STREET_FRAMES (150),
+#   PHOTOS (../shared/images), MODEL (../shared/models/yolox_nano.onnx); SKIP_RUNS=1 only
+#   prints the table from earlier results in WORK_DIR.
+# Per sequence: `ademono synth --actor-photos`, `ademono recall` (YOLOX-nano's recall against the
+# ground-truth boxes), then `ademono ablate` three times: YOLOX-nano (full, no_dynamic) and the
+# ground-truth boxes (full). Prints one markdown table with the four criteria:
+#   ATE(yolox) <= 1.5 ATE(gt boxes); ATE(yolox) <= 0.3 ATE(no removal);
+#   >= 90 % of moving keypoints removed (and the share of those outside every detector box);
+#   <= 10 % of static keypoints removed.
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+bin="${1:-$here/build/release/bin/ademono}"
+work="${2:-/tmp/ademono_synthetic_dynamic}"
+shift $(( $# < 2 ? $# : 2 ))
+[ "${1:-}" = "--" ] && shift
+extra=("$@")
+photos="${PHOTOS:-$here/../shared/images}"
+model="${MODEL:-$here/../shared/models/yolox_nano.onnx}"
+office_seeds="${OFFICE_SEEDS:-7 5 11}"
+street_seeds="${STREET_SEEDS:-1 2 3}"
+mkdir -p "$work"
+
+run_one() {  # scene seed
+  local scene=$1 seed=$2 seq="$work/$1_s$2" frames config depth
+  if [ "$scene" = office ]; then
+    frames=${OFFICE_FRAMES:-300}
+    config=()
+    depth=simulated
+    [ -d "$seq/rgb" ] || "$bin" synth --scene office --motion xyz --persons 3 --frames "$frames" \
+      --seed "$seed" --actor-photos "$photos" --out "$seq" >/dev/null
+  else
+    frames=${STREET_FRAMES:-150}
+    config=(--config "$here/configs/street.yaml")
+    depth="simulated:gt=$seq/depth_full"
+    [ -d "$seq/rgb" ] || "$bin" synth --scene street --frames "$frames" --seed "$seed" \
+      --actor-photos "$photos" --out "$seq" >/dev/null
+  fi
+  "$bin" recall --sequence "$seq" --detector "model:$model" --json "$work/$scene"_s"$seed"_recall.json \
+    > "$work/$scene"_s"$seed"_recall.md
+  rm -rf "$work/$scene"_s"$seed"_yolox "$work/$scene"_s"$seed"_gt
+  "$bin" ablate --dataset "tum:$seq" "${config[@]}" --depth "$depth" --detector "model:$model" \
+    --variants full,no_dynamic --out "$work/$scene"_s"$seed"_yolox "${extra[@]}" >/dev/null
+  "$bin" ablate --dataset "tum:$seq" "${config[@]}" --depth "$depth" \
+    --detector "cache:$seq/detections.jsonl" --variants full --out "$work/$scene"_s"$seed"_gt \
+    "${extra[@]}" >/dev/null
+}
+
+if [ "${SKIP_RUNS:-0}" != 1 ]; then
+  for seed in $office_seeds; do run_one office "$seed"; done
+  for seed in $street_seeds; do run_one street "$seed"; done
+fi
+
+/usr/bin/python3 - "$work" "$office_seeds" "$street_seeds" <<'PY'
+import json, os, sys
+work, office, street = sys.argv[1], sys.argv[2].split(), sys.argv[3].split()
+def variants(path):
+    try:
+        return {v["variant"]: v for v in json.load(open(path))["variants"]}
+    except OSError:
+        return None
+def pct(a, b):
+    return (100.0 * a / b, "%.1f%% (%d/%d)" % (100.0 * a / b, a, b)) if b else (None, "-")
+print("| scene | seed | YOLOX recall: persons / cars (photo movers) | ATE se3 yolox | ATE se3 gt boxes | ATE se3 no removal | yolox/gt <= 1.5 | yolox/none <= 0.3 | moving removed >= 90% | of them unboxed, removed | static removed <= 10% | tracked yolox / gt / none | ATE sim3 yolox / gt / none |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+ok_all = True
+for scene, seeds in (("office", office), ("street", street)):
+    for seed in seeds:
+        base = os.path.join(work, "%s_s%s" % (scene, seed))
+        y, g = variants(base + "_yolox/ablation.json"), variants(base + "_gt/ablation.json")
+        if not y or not g:
+            print("| %s | %s | missing results | | | | | | | | | | |" % (scene, seed)); ok_all = False; continue
+        rec = json.load(open(base + "_recall.json"))
+        def group_recall(cls):
+            t = sum(x["truth_boxes"] for x in rec.get("groups", []) if x["class"] == cls and "photo" in x["label"])
+            f = sum(x["found"] for x in rec.get("groups", []) if x["class"] == cls and "photo" in x["label"])
+            return "%.2f" % (f / t) if t else "-"
+        full, nodyn, gt = y["full"], y["no_dynamic"], g["full"]
+        a, an, ag = full["ate_se3_rmse_m"], nodyn["ate_se3_rmse_m"], gt["ate_se3_rmse_m"]
+        t = full["truth"] or {}
+        r1 = a / ag if a is not None and ag else None
+        r2 = a / an if a is not None and an else None
+        mv, mvs = pct(t.get("moving_removed", 0), t.get("moving_keypoints", 0))
+        _, ubs = pct(t.get("moving_unboxed_removed", 0), t.get("moving_unboxed_keypoints", 0))
+        st, sts = pct(t.get("static_removed", 0), t.get("static_keypoints", 0))
+        c1 = r1 is not None and r1 <= 1.5
+        c2 = r2 is not None and r2 <= 0.3
+        c3 = mv is not None and mv >= 90.0
+        c4 = st is not None and st <= 10.0
+        ok_all = ok_all and c1 and c2 and c3 and c4
+        f = lambda v: "%.4f" % v if v is not None else "-"
+        yes = lambda c, v: ("%.2f " % v if v is not None else "") + ("yes" if c else "**no**")
+        print("| %s | %s | %s / %s | %s | %s | %s | %s | %s | %s %s | %s | %s %s | %d / %d / %d of %d | %s / %s / %s |" % (
+            scene, seed, group_recall("person"), group_recall("car"), f(a), f(ag), f(an),
+            yes(c1, r1), yes(c2, r2), mvs, "yes" if c3 else "**no**", ubs, sts,
+            "yes" if c4 else "**no**", full["tracked"], gt["tracked"], nodyn["tracked"],
+            full["frames"], f(full["ate_sim3_rmse_m"]), f(gt["ate_sim3_rmse_m"]),
+            f(nodyn["ate_sim3_rmse_m"])))
+print()
+print("all criteria met" if ok_all else "NOT all criteria met")
+PY
