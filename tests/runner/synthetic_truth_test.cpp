@@ -66,6 +66,14 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   truth.Score(frame, {standing, parked, chair}, kps, labels, &unboxed);
   EXPECT_EQ(unboxed.moving_unboxed_keypoints, 2);
   EXPECT_EQ(unboxed.moving_unboxed_removed, 1);
+  // The geometric test keeping the moving keypoint 1 (labelled kept) and the static keypoint 5
+  // out of the pose counts as removing them.
+  const std::vector<uint8_t> rejected{0, 1, 0, 0, 0, 1, 0, 0, 0};
+  TruthCounts geometric;
+  truth.Score(frame, {standing, parked, chair}, kps, labels, &geometric, &rejected);
+  EXPECT_EQ(geometric.moving_removed, 2);
+  EXPECT_EQ(geometric.moving_unboxed_removed, 2);
+  EXPECT_EQ(geometric.static_removed, unboxed.static_removed + 1);
 
   frame.name = "missing";
   EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);

@@ -162,7 +162,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     f.filter = r.filter_stats;
     report.per_frame.push_back(f);
     report.filter_totals.Add(r.filter_stats, r.num_keypoints);
-    if (score) truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth);
+    if (score)
+      truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.geometric_rejected);
     if (options.on_frame) options.on_frame(frame, detections, r);
   };
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);

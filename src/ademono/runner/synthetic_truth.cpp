@@ -49,7 +49,8 @@ cv::Point Pixel(const cv::KeyPoint& kp, const cv::Size& size) {
 
 void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>& detections,
                            const std::vector<cv::KeyPoint>& keypoints,
-                           const std::vector<PointLabel>& labels, TruthCounts* counts) const {
+                           const std::vector<PointLabel>& labels, TruthCounts* counts,
+                           const std::vector<uint8_t>* geometric_rejected) const {
   const fs::path path = masks_dir_ / (frame.name + ".png");
   RequireFile(path);
   const cv::Mat mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
@@ -74,7 +75,9 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
     const cv::Point p = Pixel(keypoints[i], mask.size());
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
     if (labels[i] == PointLabel::kEnhancementDropped) continue;
-    const bool dynamic = IsDynamic(labels[i]);
+    const bool dynamic =
+        IsDynamic(labels[i]) || (geometric_rejected && i < geometric_rejected->size() &&
+                                 (*geometric_rejected)[i] != 0);
     const auto& classes = DefaultDynamicClassIds();
     const bool in_box = std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
       return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&

@@ -16,7 +16,8 @@ namespace ademono {
 
 // Keypoints scored against synthetic ground truth. Only keypoints that reach the dynamic filter
 // count (not dropped by the enhancement before it), and only dynamic-removal labels count as
-// removed (a distant drop is not the dynamic filter's doing).
+// removed (a distant drop is not the dynamic filter's doing), plus, when given, keypoints whose
+// map point the geometric test keeps out of the pose.
 struct TruthCounts {
   long long moving_keypoints = 0;         // keypoints whose pixel is in the moving-object mask
   long long moving_removed = 0;           // ... labelled dynamic
@@ -45,9 +46,11 @@ class SyntheticTruth {
   explicit SyntheticTruth(const std::filesystem::path& sequence_dir);
   bool Available() const { return available_; }
   // Throws InputError when the frame's mask is missing or not the image size.
+  // `geometric_rejected` (optional, per keypoint): 1 when the geometric test kept the keypoint's
+  // map point out of the pose; such a keypoint counts as removed like a dynamic label.
   void Score(const FrameData& frame, const std::vector<Detection>& detections,
              const std::vector<cv::KeyPoint>& keypoints, const std::vector<PointLabel>& labels,
-             TruthCounts* counts) const;
+             TruthCounts* counts, const std::vector<uint8_t>* geometric_rejected = nullptr) const;
 
  private:
   std::filesystem::path masks_dir_;

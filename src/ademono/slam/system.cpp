@@ -46,6 +46,16 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.quality = out.quality;
   result.geometric_dynamic = out.geometric_dynamic;
   result.geometric_culled = out.geometric_culled;
+  if (!out.geometric_rejected.empty()) {
+    // Back from the kept keypoints (the features) to all extracted keypoints.
+    result.geometric_rejected.assign(keypoints.size(), 0);
+    for (size_t i = 0, k = 0; i < keypoints.size(); ++i) {
+      if (labels[i] != PointLabel::kKept) continue;
+      if (k < out.geometric_rejected.size())
+        result.geometric_rejected[i] = out.geometric_rejected[k];
+      ++k;
+    }
+  }
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
   result.new_keyframe = back.new_keyframe;

@@ -41,6 +41,9 @@ struct TrackResult {
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)
+  // ... and per keypoint 1 when it was kept by the filter but matched a map point the geometric
+  // test keeps out of the pose (empty when the test is off or the frame is untracked).
+  std::vector<uint8_t> geometric_rejected;
   double extraction_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
 };
 

@@ -247,6 +247,13 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.inliers = matches_inliers_;
     out.geometric_dynamic = judged_dynamic_;
     out.geometric_culled = geometric_culled_;
+    if (options_.tracking.static_test) {
+      out.geometric_rejected.assign(frame.map_points.size(), 0);
+      for (size_t i = 0; i < frame.map_points.size(); ++i) {
+        const auto& p = frame.map_points[i];
+        if (p && !UsableForPose(*p)) out.geometric_rejected[i] = 1;
+      }
+    }
     out.depth_scale = record.depth_scale = frame.F().depth_scale;
     if (frame.F().DepthIsPrior()) {
       last_depth_scale_ = frame.F().depth_scale;

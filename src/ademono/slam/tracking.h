@@ -56,6 +56,9 @@ struct TrackingOutput {
   // map points culled for falling to the floor probability.
   int geometric_dynamic = 0;
   int geometric_culled = 0;
+  // Per keypoint of the frame's features (tracked frames, geometric test on; else empty): 1 when
+  // it matched a map point the test keeps out of the pose (P(static) below the threshold).
+  std::vector<uint8_t> geometric_rejected;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
 };
 
