@@ -48,9 +48,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.geometric_culled = out.geometric_culled;
   if (!out.geometric_rejected.empty()) {
     // Back from the kept keypoints (the features) to all extracted keypoints.
-    result.geometric_rejected.assign(keypoints.size(), 0);
-    for (size_t i = 0, k = 0; i < keypoints.size(); ++i) {
-      if (labels[i] != PointLabel::kKept) continue;
+    result.geometric_rejected.assign(extracted.keypoints.size(), 0);
+    for (size_t i = 0, k = 0; i < extracted.keypoints.size(); ++i) {
+      if (filtered.labels[i] != PointLabel::kKept) continue;
       if (k < out.geometric_rejected.size())
         result.geometric_rejected[i] = out.geometric_rejected[k];
       ++k;
