@@ -12,11 +12,10 @@ bin="${ADEMONO_BIN:-$here/build/release/bin/ademono}"
 dataset="7scenes:$here/../shared/data/7scenes-seq-a"
 work="$(mktemp -d /tmp/ademono_kill_runs.XXXXXX)"
 trap 'rm -rf "$work"' EXIT
-run() { "$bin" --log-level warn run --dataset "$dataset" --config "$here/configs/7scenes.yaml" \
-  --frames "$frames" --out "$@" >/dev/null 2>&1; }
+args=(--log-level warn run --dataset "$dataset" --config "$here/configs/7scenes.yaml" --frames "$frames")
 
 start=$(date +%s.%N)
-run "$work/ref"
+"$bin" "${args[@]}" --out "$work/ref" >/dev/null 2>&1
 full=$(python3 -c "print(round($(date +%s.%N) - $start, 2))")
 echo "uninterrupted run: ${full} s; killing $kills runs at uniform random moments in [0, 1.1 x that]"
 stable="trajectory.tum trajectory.kitti keyframes.tum map.ply groundtruth.tum config.resolved.yaml"
@@ -26,11 +25,12 @@ for ((k = 0; k < kills; k++)); do
   rm -rf "$out"
   extra=()
   if ((k % 2 == 1)); then cp -r "$work/ref" "$out"; extra=(--overwrite); fi
-  run "$out" "${extra[@]}" &
+  # The binary itself in the background (not a function: its subshell would take the kill).
+  "$bin" "${args[@]}" --out "$out" "${extra[@]}" >/dev/null 2>&1 &
   pid=$!
   sleep "$(python3 -c "import random; print(random.uniform(0, 1.1 * $full))")"
   kill -KILL "$pid" 2>/dev/null || true
-  if wait "$pid"; then finished=$((finished + 1)); else killed=$((killed + 1)); fi
+  if wait "$pid" 2>/dev/null; then finished=$((finished + 1)); else killed=$((killed + 1)); fi
   [ -d "$out" ] || { empty=$((empty + 1)); continue; }
   for f in $stable; do
     if [ -e "$out/$f" ] && ! cmp -s "$out/$f" "$work/ref/$f"; then
