@@ -27,15 +27,7 @@ cv::Mat LoadFrame() {
   return image;
 }
 
-ademono::Camera SevenScenesCamera() {
-  ademono::Camera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 585;
-  camera.cx = 320;
-  camera.cy = 240;
-  return camera;
-}
+ademono::Camera SevenScenesCamera() { return ademono::Camera::Pinhole(640, 480, 585, 320, 240); }
 
 void BM_YoloxNano640x480(benchmark::State& state) {
   const cv::Mat image = LoadFrame();

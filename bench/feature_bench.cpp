@@ -189,12 +189,7 @@ BENCHMARK(BM_MatchQuality)->Arg(1)->Arg(5)->Arg(30)->Unit(benchmark::kMillisecon
 // fits the camera motion to the background).
 void BM_FeatureFilter(benchmark::State& state) {
   const ademono::OrbExtractor extractor{ademono::OrbOptions{}};
-  ademono::Camera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 585;
-  camera.cx = 320;
-  camera.cy = 240;
+  const ademono::Camera camera = ademono::Camera::Pinhole(640, 480, 585, 320, 240);
   auto load_depths = [&](const char* depth_path, const std::vector<cv::KeyPoint>& kps) {
     const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
     if (depth.empty()) throw std::runtime_error(std::string("cannot read ") + depth_path);

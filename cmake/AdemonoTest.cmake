@@ -1,9 +1,10 @@
-# ademono_add_test(<name> SOURCES ... LIBS ...)
+# ademono_add_test(<name> [CLI] SOURCES ... LIBS ...)
 # A GoogleTest executable whose tests CTest discovers. Tests find real data through
 # ADEMONO_SHARED_DIR (../shared beside the checkout), fixtures through ADEMONO_SOURCE_DIR and the
-# CLI through ADEMONO_CLI.
+# CLI through ADEMONO_CLI; only tests marked CLI (those that run it) make the CLI a build
+# dependency, so a sanitized subset (scripts/test.sh) builds just the modules it tests.
 function(ademono_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "CLI" "" "SOURCES;LIBS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
   get_filename_component(_shared "${PROJECT_SOURCE_DIR}/../shared" ABSOLUTE)
@@ -11,7 +12,9 @@ function(ademono_add_test name)
     ADEMONO_SHARED_DIR="${_shared}"
     ADEMONO_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     ADEMONO_CLI="$<TARGET_FILE:ademono_cli>")
-  add_dependencies(${name} ademono_cli)
+  if(ARG_CLI)
+    add_dependencies(${name} ademono_cli)
+  endif()
   set(_env "")
   if(ADEMONO_SANITIZE)
     # ONNX Runtime leaks 14 bytes of its own at start-up; nothing of ademono's is suppressed.

@@ -40,7 +40,7 @@ fi
 [ -n "$detector_model" ] && detector="model:$detector_model"
 
 echo "== 2/3 ademono run --dataset $dataset --depth $depth --detector $detector"
-"$bin" run --dataset "$dataset" --depth "$depth" --detector "$detector" --out "$out/run"
+"$bin" run --dataset "$dataset" --depth "$depth" --detector "$detector" --out "$out/run" --overwrite
 
 if [ -n "$gt" ]; then
   echo "== 3/3 evaluation against ground truth"

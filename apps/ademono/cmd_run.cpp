@@ -1,12 +1,17 @@
 // `ademono run`: SLAM over a dataset sequence through the runner (runner/run.h), whose writer
 // puts the run folder into --out (runner/run_writer.h); optionally per-frame feature images into
 // --viz.
+#include <fcntl.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -21,6 +26,7 @@
 #include "ademono/detect/detector_factory.h"
 #include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
+#include "ademono/io/trajectory.h"
 #include "ademono/report/report.h"
 #include "ademono/runner/run.h"
 #include "ademono/runner/run_writer.h"
@@ -39,7 +45,84 @@ struct RunArgs : SequenceRunArgs {
   bool no_distant_filter = false;
   std::string save_map, load_map;
   bool localize_only = false;
+  bool overwrite = false;
+  bool live_trajectory = false;
+  bool realtime = false;
+  double realtime_speed = 1.0;
 };
+
+// SIGINT / SIGTERM: finish the current frame, then write the outputs of the frames done so far
+// (summary.json "partial": true). SA_RESETHAND: a second signal ends the process at once, which
+// the kill-safe writer (runner/run_writer.h) makes harmless.
+std::atomic<bool> g_stop{false};
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void OnStopSignal(int signo) {
+  g_stop_signal = signo;
+  g_stop.store(true);
+}
+
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction action {};
+    action.sa_handler = OnStopSignal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &action, &old_int_);
+    sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+// --live-trajectory: DIR/trajectory.live.tum gets one line per tracked frame (its pose when it was
+// tracked, before later refinement), each fsynced, for a robot reading the run as it goes.
+class LiveTrajectory {
+ public:
+  explicit LiveTrajectory(const fs::path& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) ThrowInputError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+    Append(kTumHeader);
+  }
+  ~LiveTrajectory() { ::close(fd_); }
+  LiveTrajectory(const LiveTrajectory&) = delete;
+  LiveTrajectory& operator=(const LiveTrajectory&) = delete;
+  void Add(double timestamp, const Rigid3d& cam_from_world) {
+    Append(FormatTumLine({timestamp, cam_from_world.inverse()}));
+  }
+
+ private:
+  void Append(const std::string& line) {
+    // One write per line: a reader (or a kill) sees whole lines only, bar the very last one.
+    if (::write(fd_, line.data(), line.size()) != static_cast<ssize_t>(line.size()) ||
+        ::fdatasync(fd_) != 0) {
+      ThrowInputError(path_, std::string("write failed: ") + std::strerror(errno));
+    }
+  }
+  fs::path path_;
+  int fd_ = -1;
+};
+
+// `run` writes into an empty or new folder, or replaces a run's outputs with --overwrite (as
+// `synth` refuses a non-empty folder). A killed run's staging folder does not count.
+void CheckOutputFolder(const fs::path& out, bool overwrite) {
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec)) ThrowInputError(out, "exists and is not a directory");
+  if (overwrite) return;
+  for (const auto& entry : fs::directory_iterator(out, ec)) {
+    if (!IsStagingEntry(entry.path()))
+      ThrowInputError(out, "exists and is not empty (--overwrite replaces its run outputs)");
+  }
+}
 
 // The filter's view of the frame (boxes as the filter grew them, keypoints by label, legend).
 void WriteViz(const fs::path& dir, const FrameData& frame, const std::vector<Detection>& detections,
@@ -54,6 +137,7 @@ int Run(const RunArgs& args) {
   if (args.out.empty()) throw InputError("--out is required");
   if (args.localize_only && args.load_map.empty())
     throw InputError("--localize-only needs --load-map FILE");
+  CheckOutputFolder(args.out, args.overwrite);
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
   const std::unique_ptr<Sequence> sequence = OpenSequence(args.dataset, camera_yaml);
@@ -80,6 +164,12 @@ int Run(const RunArgs& args) {
   run.load_map = args.load_map;
   run.localize_only = args.localize_only;
   run.save_map = args.save_map;
+  const bool live_camera = sequence->Kind() == "camera";
+  if (args.realtime || live_camera) {
+    RealtimeOptions realtime;
+    realtime.speed = args.realtime_speed;
+    run.realtime = realtime;
+  }
 
   DepthFactoryContext context;
   context.sequence = sequence.get();
@@ -88,21 +178,34 @@ int Run(const RunArgs& args) {
   std::unique_ptr<Detector> detector = MakeDetector(args.detector, detector_options);
 
   const fs::path viz = args.viz;
-  const size_t total = std::min(run.pipeline.end, sequence->Size()) - run.pipeline.start;
+  // A live camera has no end: progress then shows frames without a total.
+  const size_t total =
+      live_camera ? 0 : std::min(run.pipeline.end, sequence->Size()) - run.pipeline.start;
   const bool tty = isatty(STDERR_FILENO) != 0;
   const auto start_time = std::chrono::steady_clock::now();
   size_t done = 0;
   int lost_so_far = 0;
   if (!viz.empty()) fs::create_directories(viz);
+  std::optional<LiveTrajectory> live;
+  if (args.live_trajectory) {
+    fs::create_directories(args.out);
+    live.emplace(fs::path(args.out) / "trajectory.live.tum");
+  }
   run.on_frame = [&](const FrameData& frame, const std::vector<Detection>& detections,
                      const TrackResult& r) {
     ++done;
     if (!r.tracked && r.state != TrackingState::kNotInitialized) ++lost_so_far;
     if (!viz.empty()) WriteViz(viz, frame, detections, r, options.filter);
+    if (live && r.tracked && r.cam_from_world) live->Add(frame.timestamp, *r.cam_from_world);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     const double fps = seconds > 0 ? done / seconds : 0.0;
-    if (tty) {
+    if (total == 0) {
+      if (done % 100 == 0) {
+        std::fprintf(stderr, "ademono run: %zu frames, %.1f fps, lost %d\n", done, fps,
+                     lost_so_far);
+      }
+    } else if (tty) {
       const int width = 30;
       const int filled = static_cast<int>(width * done / std::max<size_t>(1, total));
       std::fprintf(stderr, "\r[%s%s] %zu/%zu  %.1f fps  lost %d", std::string(filled, '=').c_str(),
@@ -113,7 +216,22 @@ int Run(const RunArgs& args) {
                    lost_so_far);
     }
   };
+  g_stop.store(false);
+  run.pipeline.stop = &g_stop;
+  std::optional<StopSignals> signals;
+  signals.emplace();
   const RunReport report = RunSequence(*sequence, depth.get(), detector.get(), run);
+  signals.reset();  // from here a signal ends the process; the writer below is kill-safe
+  const int stop_exit = report.partial ? 128 + static_cast<int>(g_stop_signal) : 0;
+  if (report.partial) {
+    if (tty) std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "ademono run: %s after %zu/%zu frames; writing partial outputs\n",
+                 g_stop_signal == SIGTERM ? "SIGTERM" : "SIGINT", report.frames, total);
+    if (report.trajectory.empty()) {
+      std::fprintf(stderr, "ademono run: no frame tracked yet, nothing written\n");
+      return stop_exit;
+    }
+  }
   if (report.trajectory.empty() && !args.load_map.empty()) {
     throw InputError(args.dataset + ": no frame could be relocalised in the map " + args.load_map);
   }
@@ -122,8 +240,13 @@ int Run(const RunArgs& args) {
         args.dataset +
         ": no frame could be tracked (the map never initialised: too little valid depth?)");
   }
+  if (report.realtime) {
+    std::fprintf(stderr, "ademono run: real time: %zu frames captured, %zu dropped\n",
+                 report.realtime_stats.captured, report.realtime_stats.dropped);
+  }
   if (sequence->HasGroundTruth() && !report.accuracy)
     spdlog::warn("accuracy not computed: {}", report.accuracy_note);
+  RemoveStaleStaging(args.out);
   WriteRunOutputs(report, args.out);
   WriteRunReport(args.out, ReportOptions());  // report.html, from the files just written
 
@@ -138,7 +261,7 @@ int Run(const RunArgs& args) {
   if (report.Tracked() < report.frames) {
     std::cout << (report.frames - report.Tracked()) << " frames untracked (no pose written)\n";
   }
-  return 0;
+  return stop_exit;
 }
 
 const bool kRegistered = RegisterCommand(
@@ -158,6 +281,17 @@ const bool kRegistered = RegisterCommand(
                      "start from the map in FILE: relocalise in it, then extend it");
       app.add_flag("--localize-only", args->localize_only,
                    "with --load-map: track against the loaded map without ever changing it");
+      app.add_flag("--overwrite", args->overwrite,
+                   "replace the run outputs of a folder that already holds files");
+      app.add_flag("--realtime", args->realtime,
+                   "take frames at the source's rate, dropping those tracking has no time for "
+                   "(always on for camera:N)");
+      app.add_option("--realtime-speed", args->realtime_speed,
+                     "with --realtime, replay a file this many times faster than recorded")
+          ->check(CLI::Range(0.01, 1000.0));
+      app.add_flag("--live-trajectory", args->live_trajectory,
+                   "also append each tracked frame's pose to OUT/trajectory.live.tum as it is "
+                   "tracked (one fsynced line per frame)");
       return [args] { return Run(*args); };
     });
 

@@ -33,13 +33,7 @@ cv::Mat Textured(int width, int height, int seed) {
 }
 
 ademono::Camera TestCamera(int width = kW, int height = kH) {
-  ademono::Camera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = camera.fy = 50;
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  return camera;
+  return ademono::Camera::Pinhole(width, height, 50, width / 2.0, height / 2.0);
 }
 
 class BadInputCliTest : public testing::Test {
@@ -227,6 +221,22 @@ TEST_F(BadInputCliTest, VideoWithCorruptOrMissingFrames) {
   std::ofstream(corrupt, std::ios::binary) << bytes;
   ExpectRunFails("--dataset video:" + corrupt.string() + depth,
                  corrupt.string() + ": frame 6 does not decode, but the video declares 12 frames");
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 15 part 4: a live camera that is not there fails like any bad input (this machine, like
+// CI, has no camera; device 63 and a path that is not a device are never one).
+TEST_F(BadInputCliTest, CameraThatDoesNotExist) {
+  const fs::path yaml = dir_ / "camera.yaml";
+  ademono::WriteCameraYaml(yaml, TestCamera());
+  ExpectRunFails("--dataset camera:63 --camera " + yaml.string(),
+                 "camera:63: cannot open the camera");
+  ExpectRunFails("--dataset camera:" + (dir_ / "nodevice").string() + " --camera " + yaml.string(),
+                 "cannot open the camera");
+  ExpectRunFails("--dataset camera:0", "camera:0: a live camera needs a camera YAML");
 }
 
 }  // namespace

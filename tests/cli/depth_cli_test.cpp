@@ -20,12 +20,7 @@ class DepthCliTest : public testing::Test {
     dir_ = FreshTempDir("depth_cli");
     image_ = dir_ / "grey.png";
     cv::imwrite(image_.string(), cv::Mat(96, 128, CV_8UC3, cv::Scalar::all(51)));
-    ademono::Camera camera;
-    camera.width = 128;
-    camera.height = 96;
-    camera.fx = camera.fy = 100;
-    camera.cx = 64;
-    camera.cy = 48;
+    const ademono::Camera camera = ademono::Camera::Pinhole(128, 96, 100, 64, 48);
     camera_ = dir_ / "camera.yaml";
     ademono::WriteCameraYaml(camera_, camera);
   }

@@ -13,15 +13,7 @@
 namespace ademono {
 namespace {
 
-Camera Vga() {
-  Camera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = c.fy = 525;
-  c.cx = 319.5;
-  c.cy = 239.5;
-  return c;
-}
+Camera Vga() { return Camera::Pinhole(640, 480, 525, 319.5, 239.5); }
 
 TEST(CameraPrincipalPointTest, InsideOrOnTheBorderIsAccepted) {
   EXPECT_NO_THROW(Vga().Check());

@@ -19,13 +19,7 @@ namespace fs = std::filesystem;
 const fs::path kModels = fs::path(ADEMONO_SOURCE_DIR) / "tests/data/models";
 
 Camera MakeCamera(int width, int height, double f = 500.0) {
-  Camera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = camera.fy = f;
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  return camera;
+  return Camera::Pinhole(width, height, f, width / 2.0, height / 2.0);
 }
 
 cv::Mat Grey(int width, int height, int value) {

@@ -6,14 +6,6 @@
 namespace ademono::filter_test {
 
 // An ideal 640x480 pinhole with f = 500 px and the principal point at the centre.
-inline Camera TestCamera() {
-  Camera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = c.fy = 500;
-  c.cx = 320;
-  c.cy = 240;
-  return c;
-}
+inline Camera TestCamera() { return Camera::Pinhole(640, 480, 500, 320, 240); }
 
 }  // namespace ademono::filter_test

@@ -54,15 +54,7 @@ RealFrame Load(int frame) {
   return f;
 }
 
-Camera SevenScenesCamera() {
-  Camera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = c.fy = 585;
-  c.cx = 320;
-  c.cy = 240;
-  return c;
-}
+Camera SevenScenesCamera() { return Camera::Pinhole(640, 480, 585, 320, 240); }
 
 class RealFramesTest : public ::testing::TestWithParam<bool> {
  protected:

@@ -17,12 +17,7 @@ namespace ademono {
 namespace {
 
 TEST(FeatureFilterRobustnessTest, RandomInputsGiveValidLabels) {
-  Camera camera;
-  camera.width = 320;
-  camera.height = 240;
-  camera.fx = camera.fy = 300;
-  camera.cx = 160;
-  camera.cy = 120;
+  Camera camera = Camera::Pinhole(320, 240, 300, 160, 120);
   camera.distortion = {0.05, -0.01, 0.001, 0.0, 0.0};
   const float nan = std::numeric_limits<float>::quiet_NaN();
   FeatureFilter filter{FilterOptions{}};

@@ -133,7 +133,8 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
   EXPECT_EQ(Keys(s),
             (std::set<std::string>{"schema",    "dataset",       "config",        "depth",
                                    "detector",  "seed",          "deterministic", "filters",
-                                   "frames",    "tracked",       "untracked",     "lost",
+                                   "frames",    "partial",       "tracked",       "untracked",
+                                   "lost",
                                    "keyframes", "map_points",    "wall_seconds",  "fps",
                                    "timing",    "filter_counts", "accuracy",      "per_frame",
                                    "loops",     "weak_poses",    "geometric_test"}));

@@ -9,15 +9,8 @@
 
 namespace ademono::testing_util {
 
-inline Camera TestCamera() {
-  Camera camera;
-  camera.width = 640;
-  camera.height = 480;
-  camera.fx = camera.fy = 585;
-  camera.cx = 320;
-  camera.cy = 240;
-  return camera;
-}
+// The 7-Scenes intrinsics.
+inline Camera TestCamera() { return Camera::Pinhole(640, 480, 585, 320, 240); }
 
 inline std::shared_ptr<const FrameFeatures> TestFeatures(const std::vector<cv::Point2f>& points,
                                                          const std::vector<float>& depth,

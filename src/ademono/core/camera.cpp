@@ -92,6 +92,16 @@ bool Camera::InImage(const Eigen::Vector2d& px, double border) const {
          px.y() <= height - 1 - border;
 }
 
+Camera Camera::Pinhole(int width, int height, double focal, double cx, double cy) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = focal;
+  c.cx = cx;
+  c.cy = cy;
+  return c;
+}
+
 Camera Camera::Scaled(double sx, double sy) const {
   Camera c = *this;
   c.width = static_cast<int>(std::lround(width * sx));

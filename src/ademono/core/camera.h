@@ -43,6 +43,9 @@ struct Camera {
 
   bool InImage(const Eigen::Vector2d& px, double border = 0.0) const;
 
+  // An undistorted pinhole with square pixels (fx = fy = focal).
+  static Camera Pinhole(int width, int height, double focal, double cx, double cy);
+
   // Same camera at a different resolution (intrinsics scaled).
   Camera Scaled(double scale_x, double scale_y) const;
 };

@@ -1,9 +1,12 @@
 #include "ademono/core/file_util.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -77,6 +80,20 @@ void WriteImageAtomic(const fs::path& path, const cv::Mat& image) {
     throw;
   }
 }
+
+namespace {
+void SyncPath(const fs::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) ThrowInputError(path, std::string("cannot open to sync: ") + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int sync_errno = errno;
+  ::close(fd);
+  if (rc != 0) ThrowInputError(path, std::string("fsync failed: ") + std::strerror(sync_errno));
+}
+}  // namespace
+
+void SyncFile(const fs::path& path) { SyncPath(path, O_RDONLY); }
+void SyncDirectory(const fs::path& dir) { SyncPath(dir, O_RDONLY | O_DIRECTORY); }
 
 cv::Mat ReadImage(const fs::path& path, int flags) {
   RequireFile(path);

@@ -23,6 +23,11 @@ void WriteTextFileAtomic(const std::filesystem::path& path, std::string_view tex
 // cv::imwrite through a temp file with the same extension.
 void WriteImageAtomic(const std::filesystem::path& path, const cv::Mat& image);
 
+// Flushes a written file, or a directory's entries (after renames into it), to the disk, so the
+// data survives a power loss, not only a killed process. InputError naming the path on failure.
+void SyncFile(const std::filesystem::path& path);
+void SyncDirectory(const std::filesystem::path& dir);
+
 // Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing or does not decode.
 cv::Mat ReadImage(const std::filesystem::path& path, int flags);
 

@@ -74,5 +74,11 @@ std::unique_ptr<Sequence> OpenImageFolder(const std::filesystem::path& dir,
                                           const std::optional<std::filesystem::path>& camera_yaml);
 std::unique_ptr<Sequence> OpenVideo(const std::filesystem::path& file,
                                     const std::optional<std::filesystem::path>& camera_yaml);
+// A live camera through cv::VideoCapture: `device` is a number (camera:0) or a device path
+// (camera:/dev/video2). The camera YAML is required and must match the frames' size. Size() is
+// unbounded, Kind() "camera"; Load(i) returns the camera's next frame (i only labels it) and
+// Timestamp(i) is unknown until then (seconds since open). Read by the real-time feed only.
+std::unique_ptr<Sequence> OpenCamera(const std::string& device,
+                                     const std::optional<std::filesystem::path>& camera_yaml);
 
 }  // namespace ademono

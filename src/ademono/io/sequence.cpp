@@ -13,7 +13,7 @@ std::unique_ptr<Sequence> OpenSequence(const std::string& spec,
   if (colon == std::string::npos || colon == 0 || colon + 1 == spec.size()) {
     throw InputError("sequence '" + spec +
                      "': expected KIND:PATH with KIND one of tum, kitti, euroc, 7scenes, folder, "
-                     "video");
+                     "video, camera");
   }
   const std::string kind = spec.substr(0, colon);
   const fs::path path = spec.substr(colon + 1);
@@ -24,8 +24,9 @@ std::unique_ptr<Sequence> OpenSequence(const std::string& spec,
   if (kind == "euroc") return OpenEuroc(path, camera_yaml);
   if (kind == "folder") return OpenImageFolder(path, camera_yaml);
   if (kind == "video") return OpenVideo(path, camera_yaml);
+  if (kind == "camera") return OpenCamera(path.string(), camera_yaml);
   throw InputError("sequence '" + spec + "': unknown kind '" + kind +
-                   "' (expected tum, kitti, euroc, 7scenes, folder or video)");
+                   "' (expected tum, kitti, euroc, 7scenes, folder, video or camera)");
 }
 
 }  // namespace ademono

@@ -39,7 +39,8 @@ class Sequence {
   virtual double Timestamp(size_t i) const = 0;
 };
 
-// "tum:DIR", "kitti:DIR", "euroc:DIR", "7scenes:DIR", "folder:DIR", "video:FILE".
+// "tum:DIR", "kitti:DIR", "euroc:DIR", "7scenes:DIR", "folder:DIR", "video:FILE", "camera:N" or
+// "camera:/dev/videoN" (a live camera, file_sequence.h OpenCamera).
 // `camera_yaml` overrides/supplies the camera (required for folder: and video: unless DIR holds
 // camera.yaml). Throws InputError for an unknown kind, a missing path or an empty sequence.
 std::unique_ptr<Sequence> OpenSequence(const std::string& spec,

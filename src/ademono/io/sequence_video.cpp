@@ -2,8 +2,12 @@
 // established once at open by grabbing through the file, because container frame counts are
 // often wrong. Decoding is sequential: the capture is kept at the next frame so in-order Load()
 // costs one decode; going backwards reopens the file. A mutex serialises access to the capture.
+// Also the live camera (camera:N), read through the same OpenCV capture.
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <mutex>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
 
@@ -99,7 +103,82 @@ class VideoSequence : public Sequence {
   mutable cv::Mat cached_;
 };
 
+// A live camera. Frames are read in order by the real-time feed's capture thread; there is no
+// going back, and the sequence never ends by itself (Ctrl-C ends the run).
+class CameraSequence : public Sequence {
+ public:
+  CameraSequence(std::string device, Camera camera)
+      : device_(std::move(device)), camera_(camera) {
+    const bool is_index =
+        !device_.empty() && device_.find_first_not_of("0123456789") == std::string::npos;
+    bool opened = false;
+    // OpenCV's backends log their own warnings for a missing device; the error below says it
+    // once.
+    const auto log_level = cv::utils::logging::getLogLevel();
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    // V4L2 when the build has it (Linux cameras): no GStreamer pipeline parsing of the path.
+    const int api = cv::videoio_registry::hasBackend(cv::CAP_V4L2) ? cv::CAP_V4L2 : cv::CAP_ANY;
+    try {
+      opened = is_index && device_.size() < 6 ? capture_.open(std::stoi(device_), api)
+                                              : capture_.open(device_, api);
+    } catch (const std::exception&) {
+      opened = false;
+    }
+    cv::utils::logging::setLogLevel(log_level);
+    if (!opened || !capture_.isOpened())
+      throw InputError("camera:" + device_ + ": cannot open the camera (no such device?)");
+    capture_.set(cv::CAP_PROP_FRAME_WIDTH, camera_.width);
+    capture_.set(cv::CAP_PROP_FRAME_HEIGHT, camera_.height);
+    opened_ = std::chrono::steady_clock::now();
+  }
+
+  std::string Kind() const override { return "camera"; }
+  fs::path Path() const override { return device_; }
+  size_t Size() const override { return SIZE_MAX; }
+  const Camera& GetCamera() const override { return camera_; }
+  bool HasDepth() const override { return false; }
+  bool HasGroundTruth() const override { return false; }
+  double Timestamp(size_t) const override { return Seconds(); }
+
+  FrameData Load(size_t i) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cv::Mat image;
+    if (!capture_.read(image) || image.empty())
+      throw InputError("camera:" + device_ + ": frame " + std::to_string(i) +
+                       " cannot be read (camera disconnected?)");
+    FrameData frame;
+    frame.index = i;
+    frame.timestamp = Seconds();
+    frame.name = "frame-" + std::to_string(i);
+    frame.image = ToBgr8(image, device_);
+    if (frame.image.cols != camera_.width || frame.image.rows != camera_.height) {
+      throw InputError("camera:" + device_ + ": frames are " + std::to_string(frame.image.cols) +
+                       "x" + std::to_string(frame.image.rows) + ", the camera YAML says " +
+                       std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+    }
+    return frame;
+  }
+
+ private:
+  double Seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - opened_).count();
+  }
+  std::string device_;
+  Camera camera_;
+  mutable std::mutex mutex_;
+  mutable cv::VideoCapture capture_;
+  std::chrono::steady_clock::time_point opened_;
+};
+
 }  // namespace
+
+std::unique_ptr<Sequence> OpenCamera(const std::string& device,
+                                     const std::optional<fs::path>& camera_yaml) {
+  if (!camera_yaml) {
+    throw InputError("camera:" + device + ": a live camera needs a camera YAML (--camera)");
+  }
+  return std::make_unique<CameraSequence>(device, LoadCameraYaml(*camera_yaml));
+}
 
 std::unique_ptr<Sequence> OpenVideo(const fs::path& file,
                                     const std::optional<fs::path>& camera_yaml) {

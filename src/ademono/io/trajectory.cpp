@@ -234,17 +234,21 @@ Trajectory ReadTrajectory(const fs::path& path, TrajectoryFormat format) {
   throw std::invalid_argument("unknown trajectory format");
 }
 
+const char kTumHeader[] = "# timestamp tx ty tz qx qy qz qw (world_from_cam)\n";
+
+std::string FormatTumLine(const StampedPose& pose) {
+  const Eigen::Quaterniond q(pose.world_from_cam.linear());
+  const Eigen::Vector3d t = pose.world_from_cam.translation();
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", pose.timestamp,
+                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  return buf;
+}
+
 void WriteTumTrajectory(const fs::path& path, const Trajectory& trajectory) {
   WriteFileAtomic(path, [&](std::ostream& out) {
-    out << "# timestamp tx ty tz qx qy qz qw (world_from_cam)\n";
-    char buf[256];
-    for (const auto& pose : trajectory) {
-      const Eigen::Quaterniond q(pose.world_from_cam.linear());
-      const Eigen::Vector3d t = pose.world_from_cam.translation();
-      std::snprintf(buf, sizeof(buf), "%.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", pose.timestamp,
-                    t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-      out << buf;
-    }
+    out << kTumHeader;
+    for (const auto& pose : trajectory) out << FormatTumLine(pose);
   });
 }
 

@@ -57,6 +57,10 @@ Trajectory ReadEurocTrajectory(const std::filesystem::path& path);
 Trajectory ReadKittiIndexedTrajectory(const std::filesystem::path& path);
 Trajectory ReadTrajectory(const std::filesystem::path& path, TrajectoryFormat format);
 
+// The TUM file's header line and one pose line ("timestamp tx ty tz qx qy qz qw\n"), for writers
+// that stream a trajectory line by line (run --live-trajectory).
+extern const char kTumHeader[];
+std::string FormatTumLine(const StampedPose& pose);
 void WriteTumTrajectory(const std::filesystem::path& path, const Trajectory& trajectory);
 void WriteKittiTrajectory(const std::filesystem::path& path, const Trajectory& trajectory);
 void WriteEurocTrajectory(const std::filesystem::path& path, const Trajectory& trajectory);

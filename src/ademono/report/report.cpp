@@ -119,16 +119,22 @@ AlignedRun Align(const RunFolder& run, Alignment alignment) {
   return aligned;
 }
 
-json TrajectoryJson(const RunFolder& run, const AlignedRun& aligned, double t0) {
-  json traj;
-  std::vector<Eigen::Vector3d> est;
+// traj[t_key]: times since t0; traj[xyz_key]: positions in the aligned world.
+void AddAlignedPositions(const Trajectory& poses, const AlignedRun& aligned, double t0,
+                         const char* t_key, const char* xyz_key, json& traj) {
+  std::vector<Eigen::Vector3d> xyz;
   json t = json::array();
-  for (const StampedPose& p : run.trajectory) {
-    est.push_back(Apply(aligned.gt_from_est, p.world_from_cam.translation()));
+  for (const StampedPose& p : poses) {
+    xyz.push_back(Apply(aligned.gt_from_est, p.world_from_cam.translation()));
     t.push_back(Round(p.timestamp - t0, 1e-4));
   }
-  traj["t"] = std::move(t);
-  traj["est"] = XyzColumns(est);
+  traj[t_key] = std::move(t);
+  traj[xyz_key] = XyzColumns(xyz);
+}
+
+json TrajectoryJson(const RunFolder& run, const AlignedRun& aligned, double t0) {
+  json traj;
+  AddAlignedPositions(run.trajectory, aligned, t0, "t", "est", traj);
   // Mean optical axis (camera z in the aligned world), so the 3D view starts looking the way the
   // camera looked.
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();
@@ -161,14 +167,7 @@ json TrajectoryJson(const RunFolder& run, const AlignedRun& aligned, double t0) 
     traj["ate"] = ToJson(e.ape);
     traj["scale"] = e.gt_from_est.scale;
   }
-  std::vector<Eigen::Vector3d> kf;
-  json kf_t = json::array();
-  for (const StampedPose& p : run.keyframes) {
-    kf.push_back(Apply(aligned.gt_from_est, p.world_from_cam.translation()));
-    kf_t.push_back(Round(p.timestamp - t0, 1e-4));
-  }
-  traj["kf_t"] = std::move(kf_t);
-  traj["kf"] = XyzColumns(kf);
+  AddAlignedPositions(run.keyframes, aligned, t0, "kf_t", "kf", traj);
   return traj;
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <future>
+#include <optional>
+#include <utility>
 
 #include "ademono/core/timing.h"
 
@@ -15,9 +17,10 @@ struct Prepared {
   double depth_ms = 0, detection_ms = 0;
 };
 
-Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {
+Prepared PrepareFrame(FrameData frame, const Sequence& sequence, DepthProvider* depth,
+                      Detector* detector) {
   Prepared p;
-  p.frame = sequence.Load(i);
+  p.frame = std::move(frame);
   auto start = Now();
   if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
   p.depth_ms = MsSince(start);
@@ -25,6 +28,10 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
   if (detector != nullptr) p.detections = detector->Detect(p.frame);
   p.detection_ms = MsSince(start);
   return p;
+}
+
+Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {
+  return PrepareFrame(sequence.Load(i), sequence, depth, detector);
 }
 
 }  // namespace
@@ -35,16 +42,12 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   const size_t end = std::min(options.end, sequence.Size());
   const auto wall_start = Now();
   std::future<Prepared> next;
-  for (size_t i = options.start; i < end; ++i) {
-    Prepared current;
-    if (options.overlap && next.valid()) {
-      current = next.get();  // rethrows a provider's InputError here, in frame order
-    } else {
-      current = Prepare(sequence, depth, detector, i);
-    }
-    if (options.overlap && i + 1 < end) {
-      next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector, i + 1);
-    }
+  auto stop_requested = [&] {
+    if (options.stop == nullptr || !options.stop->load()) return false;
+    result.stopped = true;
+    return true;  // a prefetch in flight is waited for by the future's destructor
+  };
+  auto track = [&](const Prepared& current) {
     TrackResult r;
     try {
       r = system.TrackFrame(current.frame, current.depth, current.detections);
@@ -68,6 +71,26 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
     gt.world_from_cam_gt = current.frame.world_from_cam_gt;
     result.ground_truth_frames.push_back(std::move(gt));
     ++result.frames;
+  };
+  if (options.feed != nullptr) {
+    while (!stop_requested()) {
+      std::optional<FrameData> frame = options.feed->Next();
+      if (!frame) break;
+      track(PrepareFrame(std::move(*frame), sequence, depth, detector));
+    }
+  } else {
+    for (size_t i = options.start; i < end && !stop_requested(); ++i) {
+      Prepared current;
+      if (options.overlap && next.valid()) {
+        current = next.get();  // rethrows a provider's InputError here, in frame order
+      } else {
+        current = Prepare(sequence, depth, detector, i);
+      }
+      if (options.overlap && i + 1 < end) {
+        next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector, i + 1);
+      }
+      track(current);
+    }
   }
   result.wall_seconds = MsSince(wall_start) / 1000.0;
   return result;

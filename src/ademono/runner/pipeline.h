@@ -4,6 +4,7 @@
 // while frame k is tracked (a one-frame prefetch); results are identical to the sequential loop
 // because providers are deterministic and tracking still sees frames in order.
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "ademono/io/sequence.h"
 #include "ademono/perception/depth_provider.h"
 #include "ademono/perception/detection.h"
+#include "ademono/runner/realtime.h"
 #include "ademono/slam/system.h"
 
 namespace ademono {
@@ -19,6 +21,13 @@ struct PipelineOptions {
   size_t start = 0;       // first frame (inclusive)
   size_t end = SIZE_MAX;  // last frame (exclusive), clamped to the sequence size
   bool overlap = true;    // prefetch depth/detections of the next frame
+  // Set from elsewhere (a SIGINT handler): the loop stops before the next frame; the frames done
+  // so far stay valid (PipelineResult::stopped).
+  const std::atomic<bool>* stop = nullptr;
+  // Real-time input: frames come from this feed (the newest captured, runner/realtime.h) until
+  // it ends, instead of Load(start..end); no prefetch (the next frame is whatever is newest when
+  // tracking is ready for it).
+  RealtimeFeed* feed = nullptr;
   // Called after each frame (in order, on the calling thread).
   std::function<void(const FrameData&, const cv::Mat& depth, const std::vector<Detection>&,
                      const TrackResult&)>
@@ -35,6 +44,7 @@ struct PipelineResult {
   std::vector<FrameData> ground_truth_frames;  // index, timestamp and gt pose (images dropped)
   size_t frames = 0;
   double wall_seconds = 0;
+  bool stopped = false;  // options.stop ended the loop before the last frame
 };
 
 // Throws InputError from the sequence or the providers (e.g. a missing cached depth map).

@@ -1,5 +1,6 @@
 #include "ademono/runner/run.h"
 
+#include <memory>
 #include <stdexcept>
 
 #include "ademono/eval/trajectory_eval.h"
@@ -166,14 +167,24 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
       truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.geometric_rejected);
     if (options.on_frame) options.on_frame(frame, detections, r);
   };
+  std::unique_ptr<RealtimeFeed> feed;
+  if (options.realtime) {
+    feed = MakeRealtimeFeed(sequence, pipeline.start, pipeline.end, *options.realtime);
+    pipeline.feed = feed.get();
+  }
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
   system.Shutdown();
   if (!options.save_map.empty()) system.SaveMap(options.save_map);
+  if (feed) {
+    report.realtime = options.realtime;
+    report.realtime_stats = feed->Stats();
+  }
 
   // The pipeline measured depth and detection (prepared ahead); the rest came with each frame.
   for (size_t i = 0; i < report.per_frame.size() && i < run.timings.size(); ++i)
     report.per_frame[i].ms = run.timings[i];
   report.frames = run.frames;
+  report.partial = run.stopped;
   report.wall_seconds = run.wall_seconds;
   report.lost = system.NumLost();
   report.keyframes = system.NumKeyFrames();
@@ -220,6 +231,15 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                   {"dynamic_removal", o.filter.enable_dynamic_removal},
                   {"distant", o.filter.enable_distant_filter}};
   j["frames"] = report.frames;
+  j["partial"] = report.partial;
+  if (report.realtime) {
+    // Frames the capture took, and those it dropped because tracking was still busy.
+    j["realtime"] = {{"speed", report.realtime->speed},
+                     {"queue", report.realtime->queue},
+                     {"captured", report.realtime_stats.captured},
+                     {"dropped", report.realtime_stats.dropped},
+                     {"max_queued", report.realtime_stats.max_queued}};
+  }
   j["tracked"] = report.Tracked();
   j["untracked"] = report.frames - report.Tracked();
   j["lost"] = report.lost;

@@ -91,6 +91,8 @@ struct RunOptions {
   std::filesystem::path load_map;
   bool localize_only = false;
   std::filesystem::path save_map;
+  // Real-time input (runner/realtime.h): frames dropped when tracking falls behind.
+  std::optional<RealtimeOptions> realtime;
   // Called after each frame, in order, on the calling thread (progress, --viz).
   std::function<void(const FrameData&, const std::vector<Detection>&, const TrackResult&)> on_frame;
 };
@@ -102,6 +104,10 @@ struct RunReport {
   size_t frames = 0, keyframes = 0, map_points = 0;
   int lost = 0;
   double wall_seconds = 0;
+  // Stopped early (options.pipeline.stop, e.g. Ctrl-C): the report covers the frames done so far.
+  bool partial = false;
+  std::optional<RealtimeOptions> realtime;  // as run, with what the capture did
+  RealtimeStats realtime_stats;
   std::vector<FrameReport> per_frame;
   FilterTotals filter_totals;
   // Keys extraction, depth, detection, filter, tracking, local_mapping.

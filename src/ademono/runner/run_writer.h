@@ -6,7 +6,9 @@
 //   groundtruth.tum                   the dataset's poses associated with trajectory.tum
 //                                     (only with ground truth; unaligned)
 //   summary.json                      RunSummaryJson (schema "ademono.run/1", docs/slam.md)
-// Each file is written atomically (temp file + rename); summary.json last.
+//   config.resolved.yaml              the options as run
+// Kill-safe: all files are written and fsynced in DIR/.staging.<pid>/, then renamed into DIR one
+// by one, summary.json last; a SIGKILL at any moment leaves each file complete or absent.
 
 #include <filesystem>
 #include <vector>
@@ -17,6 +19,11 @@
 namespace ademono {
 
 void WriteRunOutputs(const RunReport& report, const std::filesystem::path& out_dir);
+
+// A staging folder a killed run left behind (DIR/.staging.<pid>): not an output; removed by
+// RemoveStaleStaging, ignored when deciding whether a folder already holds outputs.
+bool IsStagingEntry(const std::filesystem::path& entry);
+void RemoveStaleStaging(const std::filesystem::path& out_dir);
 
 void WritePly(const std::filesystem::path& path, const std::vector<System::ColoredPoint>& cloud);
 

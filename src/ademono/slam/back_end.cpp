@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -145,6 +146,13 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
         point_colors_[p->id] = frame.image.channels() == 3
                                    ? frame.image.at<cv::Vec3b>(y, x)
                                    : cv::Vec3b::all(frame.image.at<uint8_t>(y, x));
+      }
+      // Colours of culled points go too, so memory follows the map, not the run's length
+      // (a saturated map keeps creating and culling points).
+      const auto& points = map_.MapPoints();
+      if (point_colors_.size() > 2 * points.size() + 1024) {
+        for (auto it = point_colors_.begin(); it != point_colors_.end();)
+          it = points.count(it->first) != 0 ? std::next(it) : point_colors_.erase(it);
       }
     }
   }

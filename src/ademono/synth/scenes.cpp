@@ -102,11 +102,8 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   Rng rng(SubSeed(options.seed, 0x0FF1CE));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E87));
   scene.fps = 30.0;
-  Camera camera;
-  camera.width = 640, camera.height = 480;
-  camera.fx = camera.fy = 525.0;
-  camera.cx = 319.5, camera.cy = 239.5;
-  scene.camera = ScaledCamera(camera, options.width, options.height);
+  scene.camera =
+      ScaledCamera(Camera::Pinhole(640, 480, 525.0, 319.5, 239.5), options.width, options.height);
   scene.sky_bgr = {0.f, 0.f, 0.f};  // never visible inside the room
 
   // Room: x in [-3, 3], y in [-2.5, 2.5], z in [0, 3]; one texture per wall.
@@ -220,11 +217,8 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   Rng rng(SubSeed(options.seed, 0x57EE7));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E88));
   scene.fps = 10.0;
-  Camera camera;
-  camera.width = 1241, camera.height = 376;
-  camera.fx = camera.fy = 718.856;
-  camera.cx = 607.1928, camera.cy = 185.2157;
-  scene.camera = ScaledCamera(camera, options.width, options.height);
+  scene.camera = ScaledCamera(Camera::Pinhole(1241, 376, 718.856, 607.1928, 185.2157),
+                              options.width, options.height);
   scene.sky_bgr = {235.f, 205.f, 170.f};
 
   const double speed = 10.0;

@@ -1,0 +1,160 @@
+// Soak: a long synthetic office run straight from synth's renderer into slam::System (no images
+// on disk), the camera going back and forth along the office's path so the map saturates
+// (issue 16 part 3). Reports, per 1000-frame window, the tracking fps, the resident memory and
+// the map's size; and peak RSS at 1k, 5k and 10k frames as benchmark counters. Peak RSS is per
+// process: run one variant per process (tools/soak.sh does).
+//
+//   build/release/bench/bench_soak                      # 10,000 frames, three variants
+//   ADEMONO_SOAK_FRAMES=3000 build/release/bench/bench_soak --benchmark_filter=Soak/Plain/
+//
+// Variants: Plain (exact depth, no detections), Detections (the persons' ground-truth boxes, as
+// `--detector cache:` of a synth folder), NetworkDepth (simulated network depth: scale bias,
+// per-frame jitter, edge errors; depth treated as a prior with scale correction, as with
+// `--depth model:`).
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "ademono/depth/simulated_depth.h"
+#include "ademono/slam/system.h"
+#include "ademono/synth/generator.h"
+#include "ademono/synth/scenes.h"
+
+namespace {
+
+using namespace ademono;
+
+enum Variant { kPlain = 0, kDetections = 1, kNetworkDepth = 2 };
+const char* const kVariantNames[] = {"plain", "detections", "network_depth"};
+
+size_t SoakFrames() {
+  const char* env = std::getenv("ADEMONO_SOAK_FRAMES");
+  return env != nullptr ? std::strtoul(env, nullptr, 10) : 10000;
+}
+
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // KB on Linux
+}
+
+double CurrentRssMb() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+SystemOptions Options(Variant variant) {
+  SystemOptions options;
+  if (variant == kNetworkDepth) {
+    // What `ademono run --depth model:...` picks indoors: depth as a prior with scale correction.
+    const std::string path = std::string(ADEMONO_SOURCE_DIR) + "/configs/network_indoor.yaml";
+    options = SystemOptions::FromYaml(YAML::LoadFile(path), path);
+  }
+  options.orb.num_features = 1000;
+  options.filter.enable_dynamic_removal = variant == kDetections;
+  return options;
+}
+
+// Back and forth over the first `period` frames of the office path: 0, 1, ..., P-1, P-2, ..., 1,
+// 0, 1, ... A continuous path (no jump), revisiting the same places, so the map can saturate.
+size_t SourceFrame(size_t k, size_t period) {
+  const size_t cycle = 2 * period - 2;
+  const size_t m = k % cycle;
+  return m < period ? m : cycle - m;
+}
+
+void BM_Soak(benchmark::State& state) {
+  const auto variant = static_cast<Variant>(state.range(0));
+  const size_t frames = SoakFrames();
+  const size_t period = 300;  // 10 s of the office path at 30 fps
+  synth::SceneOptions scene_options;
+  scene_options.scene = "office";
+  scene_options.frames = period;
+  scene_options.seed = 5;
+  scene_options.persons = variant == kDetections ? 2 : 1;
+  scene_options.width = 320;
+  scene_options.height = 240;
+  const synth::Scene scene = synth::BuildScene(scene_options);
+  synth::GeneratorOptions generator;
+  generator.scene = scene_options;
+  SimulatedDepthOptions depth_options;
+  depth_options.scale = 0.88;
+  depth_options.jitter = 0.16;
+  depth_options.jitter_frames = 60;
+  depth_options.seed = 3;
+  const SimulatedDepthProvider network(depth_options, nullptr);
+
+  std::fprintf(stderr, "soak %s: %zu frames (back and forth over %zu), 320x240\n",
+               kVariantNames[variant], frames, period);
+  std::fprintf(stderr, "%8s %8s %8s %10s %10s %9s %10s\n", "frames", "fps", "lost", "rss_mb",
+               "peak_mb", "keyframes", "map_points");
+  for (auto _ : state) {
+    System system(scene.camera, Options(variant));
+    double tracking_seconds = 0;
+    int lost_in_window = 0;
+    for (size_t k = 0; k < frames; ++k) {
+      const size_t source = SourceFrame(k, period);
+      const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, source, generator);
+      FrameData frame;
+      frame.index = k;
+      frame.timestamp = k / scene.fps;  // time keeps running while the path repeats
+      frame.name = std::to_string(k);
+      frame.image = rendered.image;
+      const cv::Mat depth =
+          variant == kNetworkDepth ? network.Degrade(rendered.depth, k) : rendered.depth;
+      std::vector<Detection> detections;
+      if (variant == kDetections)
+        detections = synth::BoxesFromObjectIds(scene, rendered.object_id, generator.min_box_pixels);
+      const auto start = std::chrono::steady_clock::now();
+      const TrackResult r = system.TrackFrame(frame, depth, detections);
+      tracking_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      lost_in_window += r.tracked ? 0 : 1;
+      if ((k + 1) % 1000 == 0 || k + 1 == frames) {
+        const size_t window = (k % 1000) + 1;
+        const double peak = PeakRssMb();
+        std::fprintf(stderr, "%8zu %8.1f %8d %10.1f %10.1f %9zu %10zu\n", k + 1,
+                     window / tracking_seconds, lost_in_window, CurrentRssMb(), peak,
+                     system.NumKeyFrames(), system.NumMapPoints());
+        const size_t done = k + 1;
+        if (done == 1000) state.counters["peak_rss_1k_mb"] = peak;
+        if (done == 5000) state.counters["peak_rss_5k_mb"] = peak;
+        if (done == 10000) state.counters["peak_rss_10k_mb"] = peak;
+        if (done == 1000) state.counters["fps_first_1k"] = window / tracking_seconds;
+        state.counters["fps_last_1k"] = window / tracking_seconds;
+        tracking_seconds = 0;
+        lost_in_window = 0;
+      }
+    }
+    system.Shutdown();
+    state.counters["keyframes"] = static_cast<double>(system.NumKeyFrames());
+    state.counters["map_points"] = static_cast<double>(system.NumMapPoints());
+    state.counters["tracked"] = static_cast<double>(system.FrameTrajectory().size());
+  }
+}
+
+BENCHMARK(BM_Soak)->Name("Soak/Plain")->Arg(kPlain)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_Soak)
+    ->Name("Soak/Detections")
+    ->Arg(kDetections)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK(BM_Soak)
+    ->Name("Soak/NetworkDepth")
+    ->Arg(kNetworkDepth)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
