@@ -16,7 +16,7 @@ mkdir -p "$out"
 run() {  # name, args...
   local name=$1; shift
   rm -rf "$out/$name"
-  "$bin" run --dataset "$dataset" --depth "$depth" --out "$out/$name" "${extra[@]}" "$@" \
+  "$bin" run --overwrite --dataset "$dataset" --depth "$depth" --out "$out/$name" "${extra[@]}" "$@" \
     > "$out/$name.log" 2>&1 || echo "(run $name failed: see $out/$name.log)" >&2
 }
 run full --config "$net_config"

@@ -35,7 +35,7 @@ common=(--dataset "7scenes:$seq")
 run_case() {
   local name="$1"; shift
   echo "== $(date -u +%H:%M:%S) $name" >&2
-  "$bin" run "${common[@]}" "$@" "${extra[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 ||
+  "$bin" run --overwrite "${common[@]}" "$@" "${extra[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 ||
     { echo "bench_throughput: case $name failed, see $out/$name.log" >&2; exit 1; }
 }
 cases=(default synchronous inline)

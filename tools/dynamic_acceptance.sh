@@ -37,7 +37,7 @@ run() {  # name, dataset, depth label, detector label, removal label, run args..
   local name=$1 dataset=$2 depth_label=$3 det_label=$4 mode=$5; shift 5
   if [ "${REUSE:-0}" = 1 ] && [ -f "$work/$name/summary.json" ]; then
     :
-  elif rm -rf "${work:?}/$name" && ! "$bin" run --dataset "$dataset" --out "$work/$name" "$@" > "$work/$name.log" 2>&1; then
+  elif rm -rf "${work:?}/$name" && ! "$bin" run --overwrite --dataset "$dataset" --out "$work/$name" "$@" > "$work/$name.log" 2>&1; then
     echo "(run $name failed: see $work/$name.log)" >&2
     return
   fi

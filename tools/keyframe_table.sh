@@ -34,7 +34,7 @@ for v in "${variants[@]}"; do
   for s in $sets; do args+=(--set "$s"); done
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do sleep 1; done
   echo "== $(date -u +%H:%M:%S) $name: $sets" >&2
-  "$bin" run --dataset "7scenes:$seq" "${args[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 &
+  "$bin" run --overwrite --dataset "7scenes:$seq" "${args[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 &
 done
 wait
 python3 - "$out" "${variants[@]}" <<'PY'

@@ -33,7 +33,7 @@ run() {  # seq scene loop_enabled out
     depth="simulated:scale=0.88,jitter=0.16,jitter_frames=200"
   fi
   rm -rf "$out"
-  "$B" run --dataset "tum:$seq" --config "$config" --depth "$depth" \
+  "$B" run --overwrite --dataset "tum:$seq" --config "$config" --depth "$depth" \
     --detector "cache:$seq/detections.jsonl" --set "loop.enabled=$loop" --out "$out" \
     >"$out.log" 2>&1
 }

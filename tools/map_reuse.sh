@@ -23,11 +23,11 @@ for kind in sensor fastdepth; do
   [ "$kind" = fastdepth ] && depth="$fastdepth"
   d="$work/$kind"
   rm -rf "$d" && mkdir -p "$d"
-  "$bin" run --dataset "$data" --depth "$depth" --frames "$first" --save-map "$d/map.bin" \
+  "$bin" run --overwrite --dataset "$data" --depth "$depth" --frames "$first" --save-map "$d/map.bin" \
     --out "$d/s1" >"$d/s1.log" 2>&1
   before="$(sha256sum <"$d/map.bin")"
   for rep in a b; do
-    "$bin" run --dataset "$data" --depth "$depth" --frames "$second" --load-map "$d/map.bin" \
+    "$bin" run --overwrite --dataset "$data" --depth "$depth" --frames "$second" --load-map "$d/map.bin" \
       --localize-only --out "$d/s2$rep" >"$d/s2$rep.log" 2>&1
   done
   after="$(sha256sum <"$d/map.bin")"

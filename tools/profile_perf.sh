@@ -20,7 +20,7 @@ for v in analytic autodiff; do
   extra=()
   [ "$v" = autodiff ] && extra=(--set mapping.ba_jacobians=autodiff --set optimizer.pose_jacobians=autodiff)
   /usr/bin/time -f "$v: wall %e s, user CPU %U s" "$build/bin/ademono" run \
-    --dataset 7scenes:../shared/data/7scenes-seq-a --depth sensor --out "$out/$v" "${extra[@]}" \
+    --dataset 7scenes:../shared/data/7scenes-seq-a --depth sensor --overwrite --out "$out/$v" "${extra[@]}" \
     >"$out/$v.log" 2>&1
   tail -1 "$out/$v.log"
   "$build/bin/ademono" eval --gt "$out/$v/groundtruth.tum" --est "$out/$v/trajectory.tum" |

@@ -22,7 +22,7 @@ py=/usr/bin/python3  # Debian's, with python3-opencv
 if [ -z "$run" ]; then
   rm -rf "$work" && mkdir -p "$work"
   "$bin" synth --scene office --motion xyz --persons 2 --frames 60 --seed 7 --out "$work/seq"
-  "$bin" run --dataset "tum:$work/seq" --depth simulated --detector "cache:$work/seq/detections.jsonl" \
+  "$bin" run --overwrite --dataset "tum:$work/seq" --depth simulated --detector "cache:$work/seq/detections.jsonl" \
     --viz "$work/run/viz" --out "$work/run"
   # Until `run` writes the unified run schema itself (no-op once it does).
   "$py" "$here/tests/report/legacy_run_to_schema.py" "$work/run" "$work/seq"
