@@ -35,6 +35,9 @@ SystemOptions NetworkOptions(bool loop) {
   options.mapping.ba_max_keyframes = 20;
   options.mapping.triangulation = true;
   options.filter.enable_dynamic_removal = false;
+  // The geometric test off: with it on this short lap drifts only 0.055 m open and the closure
+  // raises it to 0.075 m (measured after the merge; open question in docs/loops.md).
+  options.tracking.static_test = false;
   options.loop.enabled = loop;
   return options;
 }
