@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <opencv2/videoio.hpp>
 
 #include "ademono/core/error.h"
 #include "ademono/runner/run.h"
@@ -112,6 +113,56 @@ TEST(RealtimeRunTest, OfficeReplayedFasterThanTrackingDropsFramesAndKeepsTrackin
   const nlohmann::json summary = RunSummaryJson(report);
   EXPECT_EQ(summary["realtime"]["dropped"], report.realtime_stats.dropped);
   EXPECT_EQ(summary["realtime"]["captured"], 60);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// Depth for a video (which has none): the same frame index of the sequence it was made from.
+class DepthOfSource : public DepthProvider {
+ public:
+  explicit DepthOfSource(const Sequence& source) : source_(source) {}
+  std::string Name() const override { return "depth-of-source"; }
+  cv::Mat Depth(const FrameData& frame, const Camera&) override {
+    cv::Mat depth = source_.Load(frame.index).depth.clone();
+    depth.forEach<float>([](float& z, const int*) {
+      if (!std::isfinite(z) || z < 0.f) z = 0.f;
+    });
+    return depth;
+  }
+
+ private:
+  const Sequence& source_;
+};
+
+TEST(RealtimeRunTest, VideoReplayedFasterThanTrackingDropsFramesAndKeepsTracking) {
+  const fs::path dir = runner_test::TempDir("realtime_video");
+  const fs::path office = runner_test::RenderOffice(dir / "office", 60);
+  const auto source = OpenSequence("tum:" + office.string());
+  const fs::path video = dir / "office.avi";
+  {
+    const FrameData first = source->Load(0);
+    cv::VideoWriter writer(video.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0,
+                           first.image.size());
+    ASSERT_TRUE(writer.isOpened());
+    for (size_t i = 0; i < source->Size(); ++i) writer.write(source->Load(i).image);
+  }
+  // `video:FILE --realtime`: the file at its recorded rate, here 1000 times faster.
+  const auto sequence = OpenSequence("video:" + video.string(), office / "camera.yaml");
+  ASSERT_EQ(sequence->Size(), 60u);
+  DepthOfSource depth(*source);
+  RunOptions options;
+  RealtimeOptions realtime;
+  realtime.speed = 1000;
+  options.realtime = realtime;
+  const RunReport report = RunSequence(*sequence, &depth, nullptr, options);
+  EXPECT_EQ(report.realtime_stats.captured, 60u);
+  EXPECT_GT(report.realtime_stats.dropped, 0u);
+  EXPECT_EQ(report.frames + report.realtime_stats.dropped, 60u);
+  EXPECT_LE(report.realtime_stats.max_queued, 1u);
+  ASSERT_GE(report.frames, 2u);
+  EXPECT_EQ(report.per_frame.back().frame, 59u);
+  EXPECT_EQ(report.lost, 0);
+  EXPECT_GE(report.Tracked() + 1, report.frames);
   std::error_code ec;
   fs::remove_all(dir, ec);
 }
