@@ -249,6 +249,32 @@ TEST_F(ReportTest, CriticalPathFromTheMediansWithoutPerFrameTimes) {
   EXPECT_DOUBLE_EQ(cp["worker_median_ms"].get<double>(), 55.0);
 }
 
+// A newer summary says where each stage ran: extraction on the prefetch worker moves there.
+TEST_F(ReportTest, CriticalPathPutsStagesOnTheThreadTheSummaryNames) {
+  WriteRunFolder(root_ / "run");
+  json summary = json::parse(ReadTextFile(root_ / "run" / "summary.json"));
+  for (json& f : summary["per_frame"]) f.erase("ms");
+  auto stage = [](double median, const char* thread) {
+    return json{{"median_ms", median}, {"p95_ms", median}, {"thread", thread}};
+  };
+  summary["timing"] = {{"decode", stage(3.0, "prefetch")},
+                       {"extraction", stage(8.0, "prefetch")},
+                       {"keypoint_depth", stage(0.5, "prefetch")},
+                       {"depth", stage(0.5, "prefetch")},
+                       {"detection", stage(0.0, "prefetch")},
+                       {"filter", stage(1.0, "tracking")},
+                       {"tracking", stage(7.0, "tracking")},
+                       {"local_mapping", stage(2.0, "mapping")},
+                       {"tracking_thread", stage(9.0, "tracking")}};
+  WriteTextFileAtomic(root_ / "run" / "summary.json", summary.dump());
+  const json cp = RunReportData(ReadRunFolder(root_ / "run"), ReportOptions())["critical_path"];
+  // Worker 3 + 8 + 0.5 + 0.5 + 0 = 12 ms against main 1 + 7 + 2 = 10 ms.
+  EXPECT_EQ(cp["critical_branch"], "worker");
+  EXPECT_EQ(cp["dominant_stage"], "extraction");
+  EXPECT_DOUBLE_EQ(cp["main_median_ms"].get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(cp["worker_median_ms"].get<double>(), 12.0);
+}
+
 TEST_F(ReportTest, SubsamplesTheMapBeyondTheCap) {
   WriteRunFolder(root_ / "run");
   ReportOptions options;

@@ -146,8 +146,18 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
             (std::set<std::string>{"enabled", "matches_judged_dynamic", "map_points_culled"}));
   EXPECT_EQ(Keys(s["filters"]),
             (std::set<std::string>{"enhancement", "dynamic_removal", "distant"}));
-  EXPECT_EQ(Keys(s["timing"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
-                                                      "tracking", "local_mapping"}));
+  EXPECT_EQ(Keys(s["timing"]),
+            (std::set<std::string>{"decode", "extraction", "keypoint_depth", "depth", "detection",
+                                   "filter", "tracking", "local_mapping", "prefetch_wait",
+                                   "tracking_thread", "prefetch_thread"}));
+  // With the prefetch (overlap), everything but filters and tracking runs ahead on its thread.
+  for (const char* stage :
+       {"decode", "extraction", "keypoint_depth", "depth", "detection", "prefetch_thread"})
+    EXPECT_EQ(s["timing"][stage]["thread"], "prefetch") << stage;
+  for (const char* stage : {"filter", "tracking", "prefetch_wait", "tracking_thread"})
+    EXPECT_EQ(s["timing"][stage]["thread"], "tracking") << stage;
+  EXPECT_GT(s["timing"]["tracking_thread"]["median_ms"].get<double>(), 0.0);
+  EXPECT_GT(s["timing"]["prefetch_thread"]["median_ms"].get<double>(), 0.0);
   EXPECT_EQ(
       Keys(s["accuracy"]),
       (std::set<std::string>{"matched_poses", "ate_se3_rmse_m", "ate_sim3_rmse_m", "sim3_scale",
@@ -166,8 +176,10 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
                                      "dynamic_points_culled", "pose_quality", "static_points",
                                      "geometric_dynamic", "geometric_culled", "filter", "ms"}))
         << i;
-    EXPECT_EQ(Keys(f["ms"]), (std::set<std::string>{"extraction", "depth", "detection", "filter",
-                                                    "tracking", "mapping"}));
+    EXPECT_EQ(Keys(f["ms"]),
+              (std::set<std::string>{"decode", "extraction", "keypoint_depth", "depth", "detection",
+                                     "filter", "tracking", "mapping", "prefetch_wait",
+                                     "tracking_thread_cpu", "prefetch_thread_cpu"}));
     EXPECT_EQ(f["frame"], i);
     EXPECT_EQ(f["state"], TrackingStateName(r.per_frame[i].state));
     EXPECT_EQ(f["kept"], r.per_frame[i].kept);
@@ -188,6 +200,11 @@ TEST_F(RunnerTest, SecondAndSequentialRunWritesIdenticalOutputs) {
   WriteRunOutputs(*report_, a);
   const RunReport second = Run(false);
   EXPECT_FALSE(second.truth.has_value());  // not asked for
+  // Without prefetch every stage but the BA solve runs on the tracking thread.
+  EXPECT_EQ(second.timing.at("extraction").thread, "tracking");
+  EXPECT_EQ(second.timing.at("prefetch_thread").median_ms, 0.0);
+  EXPECT_GT(second.timing.at("tracking_thread").median_ms,
+            second.timing.at("extraction").median_ms * 0.5);  // CPU, includes extraction
   WriteRunOutputs(second, sequential);
   for (const char* file :
        {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "groundtruth.tum"}) {

@@ -27,6 +27,28 @@ constexpr const char* kSchema = "ademono.run/1";
 // longer of the two branches.
 const std::vector<std::string> kWorkerStages = {"depth", "detection"};
 const std::vector<std::string> kMainStages = {"extraction", "filter", "tracking", "mapping"};
+// Stages a newer summary.json places on a thread ("timing".<stage>.thread): decode, extraction
+// and keypoint depths run on the prefetch worker when the pipeline overlaps frames.
+const std::vector<std::string> kMovableStages = {"decode", "extraction", "keypoint_depth"};
+
+// The main-thread and worker stages of a run: the fixed lists above, with kMovableStages put
+// where summary.json's "timing" says they ran (absent there: the fixed lists, older runs).
+std::pair<std::vector<std::string>, std::vector<std::string>> StageBranches(const json& timing) {
+  std::vector<std::string> main, worker;
+  auto thread_of = [&](const std::string& stage) -> std::string {
+    if (!timing.is_object() || !timing.contains(stage) || !timing[stage].is_object()) return "";
+    return timing[stage].value("thread", std::string());
+  };
+  for (const auto& s : kMovableStages) {
+    const std::string t = thread_of(s);
+    if (t == "prefetch") worker.push_back(s);
+    else if (t == "tracking" || (t.empty() && s == "extraction")) main.push_back(s);
+  }
+  for (const auto& s : kMainStages)
+    if (s != "extraction") main.push_back(s);
+  for (const auto& s : kWorkerStages) worker.push_back(s);
+  return {main, worker};
+}
 
 std::string Base64(const uint8_t* data, size_t size) {
   static const char* kAlphabet =
@@ -290,17 +312,18 @@ json FramesJson(const RunFolder& run, double t0) {
 // where mapping is called local_mapping).
 json CriticalPathFromMedians(const json& timing) {
   if (!timing.is_object() || timing.empty()) return nullptr;
+  const auto [main_stages, worker_stages] = StageBranches(timing);
   auto median = [&](const std::string& stage) {
     const std::string key = stage == "mapping" ? "local_mapping" : stage;
     return timing.contains(key) ? timing[key].value("median_ms", 0.0) : 0.0;
   };
   json stages = json::array();
   double main = 0, worker = 0;
-  for (const auto& s : kMainStages) {
+  for (const auto& s : main_stages) {
     main += median(s);
     stages.push_back({{"stage", s}, {"branch", "main"}, {"median_ms", median(s)}});
   }
-  for (const auto& s : kWorkerStages) {
+  for (const auto& s : worker_stages) {
     worker += median(s);
     stages.push_back({{"stage", s}, {"branch", "worker"}, {"median_ms", median(s)}});
   }
@@ -325,6 +348,7 @@ json CriticalPathJson(const json& frames, const json& summary) {
   json stages = json::array();
   const size_t n = frames.at("frame").size();
   if (n == 0 || ms.empty()) return CriticalPathFromMedians(summary.value("timing", json()));
+  const auto [main_stages, worker_stages] = StageBranches(summary.value("timing", json()));
   auto column = [&](const std::string& name) {
     std::vector<double> v(n, 0.0);
     if (ms.contains(name))
@@ -332,12 +356,12 @@ json CriticalPathJson(const json& frames, const json& summary) {
     return v;
   };
   std::vector<double> main(n, 0.0), worker(n, 0.0);
-  for (const auto& s : kMainStages) {
+  for (const auto& s : main_stages) {
     const std::vector<double> v = column(s);
     for (size_t i = 0; i < n; ++i) main[i] += v[i];
     stages.push_back({{"stage", s}, {"branch", "main"}, {"median_ms", Median(v)}});
   }
-  for (const auto& s : kWorkerStages) {
+  for (const auto& s : worker_stages) {
     const std::vector<double> v = column(s);
     for (size_t i = 0; i < n; ++i) worker[i] += v[i];
     stages.push_back({{"stage", s}, {"branch", "worker"}, {"median_ms", Median(v)}});

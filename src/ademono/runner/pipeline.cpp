@@ -14,24 +14,56 @@ struct Prepared {
   FrameData frame;
   cv::Mat depth;
   std::vector<Detection> detections;
-  double depth_ms = 0, detection_ms = 0;
+  ExtractedFrame extracted;
+  double decode_ms = 0, depth_ms = 0, detection_ms = 0;
+  double cpu_ms = 0;  // CPU of the thread(s) that prepared it
 };
 
-Prepared PrepareFrame(FrameData frame, const Sequence& sequence, DepthProvider* depth,
-                      Detector* detector) {
-  Prepared p;
-  p.frame = std::move(frame);
-  auto start = Now();
-  if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
-  p.depth_ms = MsSince(start);
-  start = Now();
-  if (detector != nullptr) p.detections = detector->Detect(p.frame);
-  p.detection_ms = MsSince(start);
-  return p;
+// Depth, detections, ORB features and keypoint depths of a loaded frame. With `parallel`, the ORB
+// extraction (which needs only the image) runs on its own thread beside the depth network and the
+// detector; either way the result is the same.
+void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth,
+                   Detector* detector, const System& system, bool parallel) {
+  const double cpu_start = ThreadCpuMs();
+  std::future<std::pair<ExtractedFrame, double>> features;
+  if (parallel) {
+    features = std::async(std::launch::async, [&system, &p] {
+      const double cpu = ThreadCpuMs();
+      ExtractedFrame e = system.ExtractFeatures(p.frame);
+      return std::make_pair(std::move(e), ThreadCpuMs() - cpu);
+    });
+  }
+  try {
+    auto start = Now();
+    if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
+    p.depth_ms = MsSince(start);
+    start = Now();
+    if (detector != nullptr) p.detections = detector->Detect(p.frame);
+    p.detection_ms = MsSince(start);
+  } catch (...) {
+    if (features.valid()) features.wait();  // it reads p.frame
+    throw;
+  }
+  double extraction_cpu = 0;
+  if (parallel) {
+    std::tie(p.extracted, extraction_cpu) = features.get();
+  } else {
+    p.extracted = system.ExtractFeatures(p.frame);
+  }
+  system.AddDepths(p.extracted, p.depth);
+  p.cpu_ms += ThreadCpuMs() - cpu_start + extraction_cpu;
 }
 
-Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector, size_t i) {
-  return PrepareFrame(sequence.Load(i), sequence, depth, detector);
+Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector,
+                 const System& system, bool parallel, size_t i) {
+  Prepared p;
+  const double cpu_start = ThreadCpuMs();
+  const auto start = Now();
+  p.frame = sequence.Load(i);
+  p.decode_ms = MsSince(start);
+  p.cpu_ms = ThreadCpuMs() - cpu_start;
+  PrepareLoaded(p, sequence, depth, detector, system, parallel);
+  return p;
 }
 
 }  // namespace
@@ -42,26 +74,39 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   const size_t end = std::min(options.end, sequence.Size());
   const auto wall_start = Now();
   std::future<Prepared> next;
+  // Extraction beside depth and detection only when they are real work (a network or a
+  // detector); a sensor depth map costs nothing to hide behind.
+  const bool parallel_extraction =
+      options.overlap && (detector != nullptr || (depth != nullptr && depth->Name() != "sensor"));
+  result.prefetched = options.overlap && options.feed == nullptr;
   auto stop_requested = [&] {
     if (options.stop == nullptr || !options.stop->load()) return false;
     result.stopped = true;
     return true;  // a prefetch in flight is waited for by the future's destructor
   };
-  auto track = [&](const Prepared& current) {
+  // `cpu_ms`: what the tracking thread already spent on this frame (decode/extraction inline).
+  auto track = [&](Prepared& current, double cpu_ms, double wait_ms, bool prefetched) {
+    const double cpu_start = ThreadCpuMs();
     TrackResult r;
     try {
-      r = system.TrackFrame(current.frame, current.depth, current.detections);
+      r = system.TrackFrame(current.frame, current.depth, current.detections,
+                            std::move(current.extracted));
     } catch (...) {
       if (next.valid()) next.wait();  // never leave the worker running on a dying pipeline
       throw;
     }
     FrameTiming t;
+    t.decode_ms = current.decode_ms;
     t.extraction_ms = r.extraction_ms;
+    t.keypoint_depth_ms = r.keypoint_depth_ms;
     t.depth_ms = current.depth_ms;
     t.detection_ms = current.detection_ms;
     t.filter_ms = r.filter_ms;
     t.tracking_ms = r.tracking_ms;
     t.mapping_ms = r.mapping_ms;
+    t.prefetch_wait_ms = wait_ms;
+    t.tracking_thread_ms = cpu_ms + ThreadCpuMs() - cpu_start;
+    t.prefetch_thread_ms = prefetched ? current.cpu_ms : 0;
     result.timings.push_back(t);
     if (options.on_frame) options.on_frame(current.frame, current.depth, current.detections, r);
     FrameData gt;
@@ -76,20 +121,29 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
     while (!stop_requested()) {
       std::optional<FrameData> frame = options.feed->Next();
       if (!frame) break;
-      track(PrepareFrame(std::move(*frame), sequence, depth, detector));
+      Prepared current;
+      current.frame = std::move(*frame);
+      PrepareLoaded(current, sequence, depth, detector, system, false);
+      track(current, current.cpu_ms, 0, false);
     }
   } else {
     for (size_t i = options.start; i < end && !stop_requested(); ++i) {
       Prepared current;
-      if (options.overlap && next.valid()) {
+      double inline_cpu = 0, wait_ms = 0;
+      const bool prefetched = options.overlap && next.valid();
+      if (prefetched) {
+        const auto wait_start = Now();
         current = next.get();  // rethrows a provider's InputError here, in frame order
+        wait_ms = MsSince(wait_start);
       } else {
-        current = Prepare(sequence, depth, detector, i);
+        current = Prepare(sequence, depth, detector, system, false, i);
+        inline_cpu = current.cpu_ms;
       }
       if (options.overlap && i + 1 < end) {
-        next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector, i + 1);
+        next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector,
+                          std::cref(system), parallel_extraction, i + 1);
       }
-      track(current);
+      track(current, inline_cpu, wait_ms, prefetched);
     }
   }
   result.wall_seconds = MsSince(wall_start) / 1000.0;

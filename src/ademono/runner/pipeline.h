@@ -1,8 +1,11 @@
 #pragma once
-// The per-frame loop of a run (runner/run.h): load frame, compute its depth and detections, track
-// it. With `overlap`, frame k+1 is loaded and its depth and detections computed on a worker thread
-// while frame k is tracked (a one-frame prefetch); results are identical to the sequential loop
-// because providers are deterministic and tracking still sees frames in order.
+// The per-frame loop of a run (runner/run.h): load (decode) a frame, compute its depth and
+// detections, extract its ORB features and keypoint depths, track it. With `overlap`, all of that
+// but tracking is done for frame k+1 on a prefetch thread while frame k is tracked (a one-frame
+// prefetch; inside it, ORB extraction runs beside the depth network and the detector when there
+// are any); the tracking thread does filters + tracking + mapping's merges only. Results are
+// identical to the sequential loop because providers and extraction are pure functions of the
+// frame and tracking still sees frames in order.
 
 #include <atomic>
 #include <cstddef>
@@ -34,9 +37,15 @@ struct PipelineOptions {
       on_frame;
 };
 
+// Wall milliseconds per stage of one frame, except tracking_thread_ms and prefetch_thread_ms:
+// CPU milliseconds of the tracking (calling) thread for this frame (everything the loop does for
+// it there except the on_frame callback: filters, tracking, mapping's work on that thread, and
+// decode/extraction too without overlap) and of the prefetch work for it (0 without overlap).
 struct FrameTiming {
-  double extraction_ms = 0, depth_ms = 0, detection_ms = 0, filter_ms = 0, tracking_ms = 0,
-         mapping_ms = 0;
+  double decode_ms = 0, extraction_ms = 0, keypoint_depth_ms = 0, depth_ms = 0, detection_ms = 0,
+         filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
+  double prefetch_wait_ms = 0;  // the tracking thread waited this long for the prefetch (wall)
+  double tracking_thread_ms = 0, prefetch_thread_ms = 0;
 };
 
 struct PipelineResult {
@@ -45,6 +54,7 @@ struct PipelineResult {
   size_t frames = 0;
   double wall_seconds = 0;
   bool stopped = false;  // options.stop ended the loop before the last frame
+  bool prefetched = false;  // decode, depth, detection and extraction ran on the prefetch thread
 };
 
 // Throws InputError from the sequence or the providers (e.g. a missing cached depth map).

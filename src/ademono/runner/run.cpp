@@ -117,11 +117,12 @@ Trajectory AssociatedGroundTruth(const Trajectory& ground_truth, const Trajector
   return associated;
 }
 
-StageTiming Timing(const std::vector<FrameReport>& frames, double FrameTiming::*stage) {
+StageTiming Timing(const std::vector<FrameReport>& frames, double FrameTiming::*stage,
+                   std::string thread) {
   std::vector<double> values;
   values.reserve(frames.size());
   for (const FrameReport& f : frames) values.push_back(f.ms.*stage);
-  return {Percentile(values, 0.5), Percentile(std::move(values), 0.95)};
+  return {Percentile(values, 0.5), Percentile(std::move(values), 0.95), std::move(thread)};
 }
 
 }  // namespace
@@ -200,12 +201,22 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   }
   report.map_cloud = system.MapPointCloud();
   report.loops = system.Loops();
-  report.timing = {{"extraction", Timing(report.per_frame, &FrameTiming::extraction_ms)},
-                   {"depth", Timing(report.per_frame, &FrameTiming::depth_ms)},
-                   {"detection", Timing(report.per_frame, &FrameTiming::detection_ms)},
-                   {"filter", Timing(report.per_frame, &FrameTiming::filter_ms)},
-                   {"tracking", Timing(report.per_frame, &FrameTiming::tracking_ms)},
-                   {"local_mapping", Timing(report.per_frame, &FrameTiming::mapping_ms)}};
+  // Which thread each stage ran on (the first frame is always prepared on the tracking thread).
+  const std::string prep = run.prefetched ? "prefetch" : "tracking";
+  const std::string mapper = options.system.mapping.threaded ? "mapping" : "tracking";
+  report.timing = {
+      {"decode", Timing(report.per_frame, &FrameTiming::decode_ms, prep)},
+      {"extraction", Timing(report.per_frame, &FrameTiming::extraction_ms, prep)},
+      {"keypoint_depth", Timing(report.per_frame, &FrameTiming::keypoint_depth_ms, prep)},
+      {"depth", Timing(report.per_frame, &FrameTiming::depth_ms, prep)},
+      {"detection", Timing(report.per_frame, &FrameTiming::detection_ms, prep)},
+      {"filter", Timing(report.per_frame, &FrameTiming::filter_ms, "tracking")},
+      {"tracking", Timing(report.per_frame, &FrameTiming::tracking_ms, "tracking")},
+      // Structure and merge run on the tracking thread, the BA solve on `mapper`.
+      {"local_mapping", Timing(report.per_frame, &FrameTiming::mapping_ms, mapper)},
+      {"prefetch_wait", Timing(report.per_frame, &FrameTiming::prefetch_wait_ms, "tracking")},
+      {"tracking_thread", Timing(report.per_frame, &FrameTiming::tracking_thread_ms, "tracking")},
+      {"prefetch_thread", Timing(report.per_frame, &FrameTiming::prefetch_thread_ms, prep)}};
 
   Trajectory ground_truth;
   for (const FrameData& f : run.ground_truth_frames) {
@@ -263,7 +274,7 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
   j["fps"] = report.Fps();
   nlohmann::json timing = nlohmann::json::object();
   for (const auto& [stage, t] : report.timing)
-    timing[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}};
+    timing[stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}, {"thread", t.thread}};
   j["timing"] = std::move(timing);
   j["filter_counts"] = report.filter_totals.ToJson();
   if (report.accuracy) j["accuracy"] = report.accuracy->ToJson();
@@ -296,12 +307,17 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                          {"geometric_culled", f.geometric_culled},
                          {"filter", FilterStatsJson(f.filter)},
                          {"ms",
-                          {{"extraction", f.ms.extraction_ms},
+                          {{"decode", f.ms.decode_ms},
+                           {"extraction", f.ms.extraction_ms},
+                           {"keypoint_depth", f.ms.keypoint_depth_ms},
                            {"depth", f.ms.depth_ms},
                            {"detection", f.ms.detection_ms},
                            {"filter", f.ms.filter_ms},
                            {"tracking", f.ms.tracking_ms},
-                           {"mapping", f.ms.mapping_ms}}}});
+                           {"mapping", f.ms.mapping_ms},
+                           {"prefetch_wait", f.ms.prefetch_wait_ms},
+                           {"tracking_thread_cpu", f.ms.tracking_thread_ms},
+                           {"prefetch_thread_cpu", f.ms.prefetch_thread_ms}}}});
     if (f.depth_scale) per_frame.back()["depth_scale"] = *f.depth_scale;
   }
   j["per_frame"] = std::move(per_frame);

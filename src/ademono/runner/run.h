@@ -76,6 +76,9 @@ std::optional<RunAccuracy> ComputeAccuracy(const Trajectory& ground_truth,
 
 struct StageTiming {
   double median_ms = 0, p95_ms = 0;
+  // Where the stage ran: "prefetch", "tracking" or "mapping" (the mapping thread). *_thread
+  // stages are CPU time of that thread per frame, the others wall time (pipeline.h FrameTiming).
+  std::string thread;
 };
 
 struct RunOptions {

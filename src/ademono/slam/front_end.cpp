@@ -19,6 +19,12 @@ FrontEnd::FrontEnd(const Camera& camera, const SystemOptions& options)
       filter_(options.filter) {}
 
 ExtractedFrame FrontEnd::Extract(const FrameData& frame, const cv::Mat& depth) const {
+  ExtractedFrame out = ExtractFeatures(frame);
+  AddDepths(out, depth);
+  return out;
+}
+
+ExtractedFrame FrontEnd::ExtractFeatures(const FrameData& frame) const {
   ExtractedFrame out;
   auto start = std::chrono::steady_clock::now();
   cv::Mat gray;
@@ -29,10 +35,13 @@ ExtractedFrame FrontEnd::Extract(const FrameData& frame, const cv::Mat& depth) c
   }
   if (!gray.empty()) extractor_.Extract(gray, out.keypoints, out.descriptors);
   out.extraction_ms = MsSince(start);
-  start = std::chrono::steady_clock::now();
-  out.depths = KeypointDepths(out.keypoints, depth, options_.depth);
-  out.depth_ms = MsSince(start);
   return out;
+}
+
+void FrontEnd::AddDepths(ExtractedFrame& extracted, const cv::Mat& depth) const {
+  const auto start = std::chrono::steady_clock::now();
+  extracted.depths = KeypointDepths(extracted.keypoints, depth, options_.depth);
+  extracted.depth_ms = MsSince(start);
 }
 
 FilteredFrame FrontEnd::Filter(const ExtractedFrame& extracted,

@@ -55,7 +55,11 @@ class FrontEnd {
 
   // `depth`: CV_32FC1 metres at the image's size or empty; `image` CV_8UC1 or CV_8UC3.
   // Thread-safe (const, no state): may run concurrently with Filter/Remember of another frame.
+  // Extract = ExtractFeatures + AddDepths; the two halves let a runner extract while the frame's
+  // depth is still being computed.
   ExtractedFrame Extract(const FrameData& frame, const cv::Mat& depth) const;
+  ExtractedFrame ExtractFeatures(const FrameData& frame) const;  // no depths yet
+  void AddDepths(ExtractedFrame& extracted, const cv::Mat& depth) const;
   FilteredFrame Filter(const ExtractedFrame& extracted, const std::vector<Detection>& detections,
                        const std::optional<Rigid3d>& predicted_cam_from_world);
   // After the back end: this frame's keypoints as the previous frame of the next Filter call.

@@ -14,14 +14,31 @@ System::~System() { Shutdown(); }
 
 void System::Shutdown() { back_end_.Shutdown(); }
 
-TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
-                               const std::vector<Detection>& detections) {
-  TrackResult result;
-  result.index = frame.index;
+namespace {
+
+void CheckDepth(const FrameData& frame, const cv::Mat& depth) {
   if (!depth.empty() && (depth.type() != CV_32FC1 || depth.size() != frame.image.size())) {
     throw std::invalid_argument("System::TrackFrame: depth must be CV_32FC1 at the image size");
   }
-  ExtractedFrame extracted = front_end_.Extract(frame, depth);
+}
+
+}  // namespace
+
+TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
+                               const std::vector<Detection>& detections) {
+  CheckDepth(frame, depth);
+  return TrackFrame(frame, depth, detections, front_end_.Extract(frame, depth));
+}
+
+TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
+                               const std::vector<Detection>& detections,
+                               ExtractedFrame extracted) {
+  TrackResult result;
+  result.index = frame.index;
+  CheckDepth(frame, depth);
+  if (extracted.depths.size() != extracted.keypoints.size()) {
+    throw std::invalid_argument("System::TrackFrame: extracted frame without keypoint depths");
+  }
   back_end_.HandOff();
   const FilteredFrame filtered =
       front_end_.Filter(extracted, detections, back_end_.PredictNext());
@@ -35,7 +52,8 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.num_with_depth = filtered.num_with_depth;
   result.filter_stats = filtered.filter_stats;
   result.extraction_ms = extracted.extraction_ms;
-  result.filter_ms = extracted.depth_ms + filtered.filter_ms;
+  result.keypoint_depth_ms = extracted.depth_ms;
+  result.filter_ms = filtered.filter_ms;
   result.tracking_ms = filtered.features_ms + back.tracking_ms;
   result.mapping_ms = back.mapping_ms;
   result.state = back.state;

@@ -44,7 +44,9 @@ struct TrackResult {
   // ... and per keypoint 1 when it was kept by the filter but matched a map point the geometric
   // test keeps out of the pose (empty when the test is off or the frame is untracked).
   std::vector<uint8_t> geometric_rejected;
-  double extraction_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
+  // Wall milliseconds per stage. extraction (grey + ORB) and keypoint_depth come from wherever
+  // the frame was extracted (the pipeline's prefetch thread, or TrackFrame itself).
+  double extraction_ms = 0, keypoint_depth_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
 };
 
 class System {
@@ -58,6 +60,22 @@ class System {
   // frame: tracked with 2-dof residuals only). `image` may be CV_8UC1 or CV_8UC3.
   TrackResult TrackFrame(const FrameData& frame, const cv::Mat& depth,
                          const std::vector<Detection>& detections);
+  // The same with the frame already extracted by ExtractFrame (byte-identical results: extraction
+  // is a pure function of the image and the depth map).
+  TrackResult TrackFrame(const FrameData& frame, const cv::Mat& depth,
+                         const std::vector<Detection>& detections, ExtractedFrame extracted);
+  // ORB extraction and keypoint depths of a frame, no system state: thread-safe, may run on
+  // another thread while earlier frames are tracked. ExtractFeatures + AddDepths split it so the
+  // features can be extracted while the depth map is still being computed.
+  ExtractedFrame ExtractFrame(const FrameData& frame, const cv::Mat& depth) const {
+    return front_end_.Extract(frame, depth);
+  }
+  ExtractedFrame ExtractFeatures(const FrameData& frame) const {
+    return front_end_.ExtractFeatures(frame);
+  }
+  void AddDepths(ExtractedFrame& extracted, const cv::Mat& depth) const {
+    front_end_.AddDepths(extracted, depth);
+  }
   // Finishes local mapping (threaded mode). Idempotent.
   void Shutdown();
 

@@ -446,17 +446,21 @@
     app.appendChild(timePanel);
     // The main thread's stages stacked in pipeline order; the prefetch worker (depth + detection
     // of the next frame, in parallel) as a dashed line: a frame costs the higher of the two.
-    const mainStages = ['extraction', 'filter', 'tracking', 'mapping'];
-    const workerStages = ['depth', 'detection'];
+    // Which stage ran where comes with the critical path (summary.json says it per stage); the
+    // per-thread CPU and wait columns are not stages and are left out of the stack.
+    const C0 = D.critical_path;
+    const mainStages = C0 ? C0.stages.filter((s) => s.branch === 'main').map((s) => s.stage) : ['extraction', 'filter', 'tracking', 'mapping'];
+    const workerStages = C0 ? C0.stages.filter((s) => s.branch !== 'main').map((s) => s.stage) : ['depth', 'detection'];
+    const notStages = ['prefetch_wait', 'tracking_thread_cpu', 'prefetch_thread_cpu'];
     const stages = Object.keys(F.ms);
     if (stages.length > 0) {
       const box = el('div', { id: 'plot-timing' });
       timePanel.appendChild(box);
-      const stacked = mainStages.filter((s) => F.ms[s]).concat(stages.filter((s) => !mainStages.includes(s) && !workerStages.includes(s)));
+      const stacked = mainStages.filter((s) => F.ms[s]).concat(stages.filter((s) => !mainStages.includes(s) && !workerStages.includes(s) && !notStages.includes(s)));
       const worker = F.t.map((_, i) => workerStages.reduce((a, s) => a + (F.ms[s] ? F.ms[s][i] : 0), 0));
       stackedPlot(box, 'Main-thread time per frame by module (stacked), prefetch worker dashed', 'ms', F.t,
         stacked.map((s) => ({ label: s, values: F.ms[s], color: STAGE_COLORS[s] || '#adb5bd' })), F, 2,
-        workerStages.some((s) => F.ms[s]) ? [{ label: 'worker: depth + detection', values: worker, color: '#7048e8' }] : []);
+        workerStages.some((s) => F.ms[s]) ? [{ label: 'worker: ' + workerStages.join(' + '), values: worker, color: '#7048e8' }] : []);
     } else {
       timePanel.appendChild(note('No per-frame timing in this run.'));
     }
@@ -468,7 +472,7 @@
         el('td', { style: 'text-align:left' }, el('span', { class: 'bar', style: 'width:' + Math.round(160 * s.median_ms / maxMs) + 'px;background:' + (STAGE_COLORS[s.stage] || '#adb5bd') }))));
       const bound = C.from_medians ? ' is the longer branch (from the per-stage medians in summary.json); median ' :
         ' bounds ' + (C.critical_branch === 'main' ? C.main_bound_frames : C.frames - C.main_bound_frames) + ' of ' + C.frames + ' frames; median ';
-      timePanel.appendChild(el('p', {}, 'Critical path: the ' + (C.critical_branch === 'main' ? 'main thread (extraction → filter → tracking → mapping)' : 'prefetch worker (depth + detection)') +
+      timePanel.appendChild(el('p', {}, 'Critical path: the ' + (C.critical_branch === 'main' ? 'main thread (' + C.stages.filter((s) => s.branch === 'main').map((s) => s.stage).join(' → ') + ')' : 'prefetch worker (' + C.stages.filter((s) => s.branch !== 'main').map((s) => s.stage).join(' + ') + ')') +
         bound +
         fmt(C.main_median_ms, 1) + ' ms on the main thread vs ' + fmt(C.worker_median_ms, 1) + ' ms on the worker, which runs one frame ahead. ' +
         'Dominant stage: ', el('b', {}, C.dominant_stage), ' (median ' + fmt(C.dominant_median_ms, 1) + ' ms).'));
