@@ -1,6 +1,7 @@
 // Per-frame SLAM cost on 7-Scenes (640x480) with sensor depth, on one core.
 //   BM_TrackingStep: pose tracking only (motion model / local map search, pose optimisation,
-//                    keyframe decision), i.e. TrackResult::tracking_ms, manual time.
+//                    keyframe decision), i.e. TrackResult::tracking_ms, manual time; arg 0:
+//                    pose optimisation with Ceres, 1: the built-in Levenberg-Marquardt.
 //   BM_FrameNoDepthNoDetection: everything System::TrackFrame does (ORB extraction, keypoint
 //                    depth, filters, tracking, and local mapping in deterministic mode).
 // Frames 0..kFrames-1 are loaded once; when they run out a fresh System starts again (untimed).
@@ -54,14 +55,16 @@ ademono::SystemOptions BenchOptions() {
   return options;
 }
 
-void Run(benchmark::State& state, bool tracking_only) {
+void Run(benchmark::State& state, bool tracking_only, bool ceres_pose = false) {
   const Data& data = LoadData();
-  auto system = std::make_unique<ademono::System>(data.sequence->GetCamera(), BenchOptions());
+  ademono::SystemOptions options = BenchOptions();
+  options.pose.use_ceres = ceres_pose;
+  auto system = std::make_unique<ademono::System>(data.sequence->GetCamera(), options);
   size_t i = 0;
   for (auto _ : state) {
     if (i == kFrames) {
       state.PauseTiming();
-      system = std::make_unique<ademono::System>(data.sequence->GetCamera(), BenchOptions());
+      system = std::make_unique<ademono::System>(data.sequence->GetCamera(), options);
       i = 0;
       state.ResumeTiming();
     }
@@ -72,11 +75,11 @@ void Run(benchmark::State& state, bool tracking_only) {
   }
 }
 
-void BM_TrackingStep(benchmark::State& state) { Run(state, true); }
+void BM_TrackingStep(benchmark::State& state) { Run(state, true, state.range(0) == 0); }
 void BM_FrameNoDepthNoDetection(benchmark::State& state) { Run(state, false); }
 
 // One iteration per frame of the slice: the reported time is the mean per frame.
-BENCHMARK(BM_TrackingStep)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(kFrames);
+BENCHMARK(BM_TrackingStep)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(kFrames);
 BENCHMARK(BM_FrameNoDepthNoDetection)->Unit(benchmark::kMillisecond)->Iterations(kFrames);
 
 }  // namespace

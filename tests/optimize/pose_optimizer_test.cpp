@@ -91,5 +91,35 @@ TEST(PoseOptimizerTest, DeterministicAndEmptyInput) {
                std::invalid_argument);
 }
 
+// The built-in Levenberg-Marquardt and Ceres solve the same problem: same outliers, poses equal
+// far below the noise, with depth, without, and with gross outliers (Huber rounds matter).
+TEST(PoseOptimizerTest, BuiltInSolverAgreesWithCeres) {
+  std::mt19937 rng(5);
+  const Rigid3d truth = TruePose();
+  for (const bool depth : {true, false}) {
+    auto observations = MakeObservations(truth, 250, depth, rng);
+    for (size_t i = 0; i < observations.size(); i += 7)
+      observations[i].image.pixel += Eigen::Vector2d(25, 12);
+    Rigid3d start = truth;
+    start.translation() += Eigen::Vector3d(0.04, -0.02, 0.03);
+    start.linear() =
+        start.linear() * Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    PoseOptimizerOptions lm_options, ceres_options;
+    ceres_options.use_ceres = true;
+    const auto lm = OptimizePose(kIntrinsics, start, observations, lm_options);
+    const auto ceres = OptimizePose(kIntrinsics, start, observations, ceres_options);
+    EXPECT_EQ(lm.outlier, ceres.outlier) << depth;
+    EXPECT_EQ(lm.num_inliers, ceres.num_inliers) << depth;
+    EXPECT_LT((lm.cam_from_world.matrix() - ceres.cam_from_world.matrix()).norm(), 1e-7) << depth;
+    EXPECT_LT(TranslationError(lm.cam_from_world, truth), depth ? 0.005 : 0.01) << depth;
+    for (size_t i = 0; i < observations.size(); i += 7) EXPECT_TRUE(lm.outlier[i]) << i;
+  }
+  // Auto-diff Jacobians exist only through Ceres.
+  PoseOptimizerOptions bad;
+  bad.analytic_jacobians = false;
+  EXPECT_THROW(OptimizePose(kIntrinsics, truth, MakeObservations(truth, 20, true, rng), bad),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace ademono

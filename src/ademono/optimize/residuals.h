@@ -34,6 +34,7 @@ inline Rigid3d ParamsToRigid(const double* params) {
 // Projects a world point through a camera into (u, v[, u_right]) residuals scaled by 1/sigma.
 template <int kDim>
 struct ProjectionResidual {
+  static constexpr int kDimension = kDim;
   ProjectionResidual(const PinholeIntrinsics& k, const ImageObservation& obs)
       : k(k),
         u(obs.pixel.x()),
