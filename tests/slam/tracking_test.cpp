@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/slam/system.h"
 #include "synthetic_sequence.h"
 
@@ -66,6 +67,62 @@ TEST(TrackingTest, TracksEveryFrameOfTheSyntheticOffice) {
     for (PointLabel label : r.labels) dynamic += IsDynamic(label);
   }
   EXPECT_GT(dynamic, 0);
+}
+
+// tracking.min_keyframe_spacing: keyframes at least that many frames apart (tracking never weak
+// here), fewer of them, and the trajectory still accurate.
+TEST(TrackingTest, KeyframeSpacingSpreadsKeyframes) {
+  const SyntheticOffice sequence;
+  SystemOptions dense;
+  dense.tracking.close_tracked_min = 1000;  // the close-point rule fires at every frame
+  SystemOptions spaced = dense;
+  spaced.tracking.min_keyframe_spacing = 7;
+  const RunResult a = TrackAll(sequence, dense);
+  const RunResult b = TrackAll(sequence, spaced);
+  auto keyframe_frames = [](const RunResult& run) {
+    std::vector<size_t> frames;
+    for (const TrackResult& r : run.results) {
+      if (r.new_keyframe) frames.push_back(r.index);
+    }
+    return frames;
+  };
+  const std::vector<size_t> fa = keyframe_frames(a), fb = keyframe_frames(b);
+  ASSERT_GE(fb.size(), 5u);
+  for (size_t k = 1; k < fb.size(); ++k) EXPECT_GE(fb[k] - fb[k - 1], 7u) << "keyframe " << k;
+  EXPECT_GE(fa.size(), fb.size() + 5);  // 21 against 11 measured
+  ASSERT_EQ(b.trajectory.size(), 80u);
+  double sum2 = 0;
+  for (double e : PositionErrors(sequence, b.trajectory)) sum2 += e * e;
+  EXPECT_LT(std::sqrt(sum2 / 80.0), 0.02);
+}
+
+// mapping.ba_max_fixed_keyframes: no local BA holds more fixed keyframes than the cap (without
+// the cap some do), and the trajectory stays as accurate.
+TEST(TrackingTest, LocalBaFixedKeyframesAreCapped) {
+  const SyntheticOffice sequence;
+  SystemOptions options;
+  options.mapping.threaded = false;  // the observer then runs on this thread
+  options.mapping.ba_max_keyframes = 3;
+  auto max_fixed = [&](const SystemOptions& o, RunResult* run) {
+    size_t most = 0;
+    SetBundleAdjustmentObserver([&most](const BundleAdjustmentProblem& problem) {
+      size_t fixed = 0;
+      for (const BaCamera& c : problem.cameras) fixed += c.fixed;
+      most = std::max(most, fixed);
+    });
+    *run = TrackAll(sequence, o);
+    SetBundleAdjustmentObserver(nullptr);
+    return most;
+  };
+  RunResult all, capped;
+  EXPECT_GT(max_fixed(options, &all), 3u);
+  options.mapping.ba_max_fixed_keyframes = 2;
+  // The first keyframe is fixed even when free: at most one more than the cap.
+  EXPECT_LE(max_fixed(options, &capped), 3u);
+  ASSERT_EQ(capped.trajectory.size(), 80u);
+  double sum2 = 0;
+  for (double e : PositionErrors(sequence, capped.trajectory)) sum2 += e * e;
+  EXPECT_LT(std::sqrt(sum2 / 80.0), 0.02);
 }
 
 }  // namespace

@@ -36,7 +36,6 @@ class KeyFrame {
   // Scratch of the tracker and local mapping.
   uint64_t local_map_frame = UINT64_MAX;
   uint64_t ba_local_for = UINT64_MAX;
-  uint64_t ba_fixed_for = UINT64_MAX;
   uint64_t fuse_target_for = UINT64_MAX;
 
   const FrameFeatures& F() const { return *features; }

@@ -59,8 +59,12 @@ void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, siz
       const int created = CreateNewMapPoints(*keyframe);
       spdlog::debug("keyframe {}: {} map points triangulated", keyframe->id, created);
     }
+    const double structure_ms = MsSinceStart(start);
     FuseNeighbours(*keyframe);
+    const double fuse_ms = MsSinceStart(start) - structure_ms;
     pending->has_ba = options_.local_ba && GatherBundleAdjustment(*keyframe, *pending);
+    spdlog::debug("keyframe {}: structure {:.1f} ms, fuse {:.1f} ms, gather {:.1f} ms", keyframe->id,
+                  structure_ms, fuse_ms, MsSinceStart(start) - structure_ms - fuse_ms);
   }
   pending->ms = MsSinceStart(start);
   pending_ = std::move(pending);
@@ -83,6 +87,12 @@ void LocalMapping::Solve(Pending& pending) const {
     pending.failure = std::current_exception();  // rethrown to tracking at the hand-off
   }
   pending.ms += MsSinceStart(start);
+  spdlog::debug("keyframe {}: BA {} cameras ({} fixed), {} points, {} observations: {:.1f} ms",
+                pending.keyframe->id, pending.problem.cameras.size(),
+                std::count_if(pending.problem.cameras.begin(), pending.problem.cameras.end(),
+                              [](const BaCamera& c) { return c.fixed; }),
+                pending.problem.points.size(), pending.problem.observations.size(),
+                MsSinceStart(start));
 }
 
 void LocalMapping::Merge() {
@@ -99,7 +109,10 @@ void LocalMapping::Merge() {
     std::lock_guard<std::mutex> lock(map_.mutex);
     if (pending->has_ba) ApplyBundleAdjustment(*pending);
     CullKeyFrames(*pending->keyframe);
+    const double cull_ms = MsSinceStart(start);
     if (loop_closing_ != nullptr && !pending->keyframe->bad) loop_closing_->Process(*pending->keyframe);
+    spdlog::debug("keyframe {}: apply + cull {:.1f} ms, loop {:.1f} ms", pending->keyframe->id,
+                  cull_ms, MsSinceStart(start) - cull_ms);
   }
   finished_ms_ += pending->ms + MsSinceStart(start);
 }
@@ -325,15 +338,26 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     }
     std::sort(local_points.begin(), local_points.end(),
               [](const MapPoint* a, const MapPoint* b) { return a->id < b->id; });
-    std::vector<KeyFrame*> fixed;
+    // Fixed keyframes and how many local points each sees.
+    std::map<KeyFrame*, int, KeyFrameIdLess> fixed_views;
     for (MapPoint* p : local_points) {
       for (const auto& [kf, idx] : p->observations) {
-        if (kf->bad || kf->ba_local_for == keyframe.id || kf->ba_fixed_for == keyframe.id) continue;
-        kf->ba_fixed_for = keyframe.id;
-        fixed.push_back(kf);
+        if (kf->bad || kf->ba_local_for == keyframe.id) continue;
+        ++fixed_views[kf];
       }
     }
-    std::sort(fixed.begin(), fixed.end(), KeyFrameIdLess());
+    std::vector<KeyFrame*> fixed;
+    for (const auto& [kf, views] : fixed_views) fixed.push_back(kf);
+    if (options_.ba_max_fixed_keyframes > 0 &&
+        fixed.size() > static_cast<size_t>(options_.ba_max_fixed_keyframes)) {
+      // Most of the cost is the fixed keyframes' residuals: keep the ones that see the most
+      // local points (ties: older first), which anchor the window as well as all of them.
+      std::stable_sort(fixed.begin(), fixed.end(), [&](KeyFrame* a, KeyFrame* b) {
+        return fixed_views[a] > fixed_views[b];
+      });
+      fixed.resize(static_cast<size_t>(options_.ba_max_fixed_keyframes));
+      std::sort(fixed.begin(), fixed.end(), KeyFrameIdLess());
+    }
 
     std::map<const KeyFrame*, size_t> camera_index;
     auto add_camera = [&](KeyFrame* kf, bool is_fixed) {

@@ -61,6 +61,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("max_local_keyframes", &T::max_local_keyframes, Range::Above(0))
           .Add("min_frames_between_keyframes", &T::min_frames_between_keyframes, Range::AtLeast(0))
           .Add("max_frames_between_keyframes", &T::max_frames_between_keyframes)
+          .Add("min_keyframe_spacing", &T::min_keyframe_spacing, Range::AtLeast(0))
           .Add("keyframe_ref_ratio", &T::keyframe_ref_ratio, Range::OpenClosed(0, 1))
           .Add("keyframe_ref_min_observations", &T::keyframe_ref_min_observations,
                Range::AtLeast(0))
@@ -101,6 +102,7 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
           .Add("fuse_neighbours", &M::fuse_neighbours, Range::AtLeast(0))
           .Add("fuse_radius", &M::fuse_radius, Range::Above(0))
           .Add("ba_max_keyframes", &M::ba_max_keyframes, Range::AtLeast(0))
+          .Add("ba_max_fixed_keyframes", &M::ba_max_fixed_keyframes, Range::AtLeast(0))
           .Add("redundant_ratio", &M::redundant_ratio, Range::OpenClosed(0, 1))
           .Add("redundant_observers", &M::redundant_observers, Range::AtLeast(1))
           .Add("triangulation", &M::triangulation)

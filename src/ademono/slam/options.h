@@ -81,6 +81,10 @@ struct TrackingOptions {
   int max_local_keyframes = 80;
   int min_frames_between_keyframes = 0;
   int max_frames_between_keyframes = 30;  // about one second at 30 Hz
+  // Frames after a keyframe during which only weak tracking (inliers below a quarter of the
+  // reference keyframe's points) may make another one: with metric depth every keyframe maps
+  // the whole view, so the close-point rule need not fire every few frames. 0: off (ORB-SLAM).
+  int min_keyframe_spacing = 0;
   double keyframe_ref_ratio = 0.75;  // tracked/reference-keyframe point ratio for a new keyframe
   // Reference-keyframe points count when seen by this many keyframes (0: ORB-SLAM's 2 or 3).
   int keyframe_ref_min_observations = 0;
@@ -118,6 +122,9 @@ struct MappingOptions {
   int handoff_frames = 0;
   bool local_ba = true;
   int ba_max_keyframes = 0;        // free keyframes in the local BA (best covisibles); 0 = all
+  // Fixed keyframes in the local BA (those seeing the most local points); 0 = every keyframe that
+  // sees a local point, as ORB-SLAM. Their residuals are most of the solve's cost.
+  int ba_max_fixed_keyframes = 0;
   double cull_found_ratio = 0.25;  // found / visible below this: point culled
   int cull_min_observations = 2;   // fewer observations two keyframes after creation: culled
   int fuse_neighbours = 10;        // covisible keyframes searched for duplicates

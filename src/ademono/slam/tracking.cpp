@@ -653,7 +653,9 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
   const bool c1a = since_kf >= static_cast<uint64_t>(t.max_frames_between_keyframes);
   const bool c1b = since_kf >= static_cast<uint64_t>(t.min_frames_between_keyframes) && idle;
-  const bool c1c = matches_inliers_ < ref_matches * 0.25 || need_close;
+  const bool weak = matches_inliers_ < ref_matches * 0.25;
+  if (!weak && since_kf < static_cast<uint64_t>(t.min_keyframe_spacing)) return false;
+  const bool c1c = weak || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
   spdlog::debug(
       "frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
