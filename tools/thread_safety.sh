@@ -31,6 +31,20 @@ for e in commands:
     print(e["directory"] + "\t" + " ".join(shlex.quote(a) for a in keep) + "\t" + e["file"])
 PY
 [ -s "$build/thread_safety.cmds" ] || { echo "thread_safety.sh: no slam sources in $build/compile_commands.json" >&2; exit 2; }
+# First, that the analysis is on at all: a member read without its mutex must be rejected.
+probe="$build/thread_safety_probe.cpp"
+cat > "$probe" <<'CPP'
+#include "ademono/core/thread_annotations.h"
+struct Probe {
+  ademono::Mutex mutex;
+  int value ADEMONO_GUARDED_BY(mutex) = 0;
+  int Unlocked() { return value; }
+  int Locked() { ademono::MutexLock lock(mutex); return value; }
+};
+CPP
+if "$clang" -std=c++17 -I"$here/src" -fsyntax-only -Wthread-safety -Werror "$probe" 2>/dev/null; then
+  echo "thread_safety.sh: the analysis did not reject an unguarded read ($probe)" >&2; exit 1
+fi
 status=0
 while IFS=$'\t' read -r dir flags file; do
   [ -z "${ADEMONO_TS_ONLY:-}" ] || [[ "$file" =~ $ADEMONO_TS_ONLY ]] || continue
