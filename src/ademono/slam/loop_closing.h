@@ -65,13 +65,15 @@ class LoopClosing {
     int matches = 0;
   };
   // Geometric verification of one candidate (steps 2 above); public for tests.
-  std::optional<Verified> Verify(KeyFrame& query, KeyFrame& candidate) const ADEMONO_REQUIRES(map_.mutex);
+  std::optional<Verified> Verify(KeyFrame& query, KeyFrame& candidate) const
+      ADEMONO_REQUIRES(map_.mutex);
   // For the analysis (core/thread_annotations.h): the caller holds the map's mutex under another
   // name. Checked at run time.
   void AssertMapHeld() const ADEMONO_ASSERT_CAPABILITY(map_.mutex) { map_.mutex.AssertHeld(); }
 
  private:
-  void Correct(KeyFrame& query, const Verified& loop, LoopEvent& event) ADEMONO_REQUIRES(map_.mutex);
+  void Correct(KeyFrame& query, const Verified& loop, LoopEvent& event)
+      ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   const KeyFrameDatabase& database_;

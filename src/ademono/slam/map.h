@@ -35,11 +35,15 @@ class Map {
   std::shared_ptr<KeyFrame> CreateKeyFrame(const Frame& frame) ADEMONO_REQUIRES(mutex);
   std::shared_ptr<MapPoint> CreateMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
                                            uint64_t frame_id) ADEMONO_REQUIRES(mutex);
-  void AddMapPoint(const std::shared_ptr<MapPoint>& point) ADEMONO_REQUIRES(mutex) { points_[point->id] = point; }
+  void AddMapPoint(const std::shared_ptr<MapPoint>& point) ADEMONO_REQUIRES(mutex) {
+    points_[point->id] = point;
+  }
   // Loading a saved map (map_io): a keyframe / point with its saved id, and the next ids.
-  std::shared_ptr<KeyFrame> RestoreKeyFrame(uint64_t id, const Frame& frame) ADEMONO_REQUIRES(mutex);
+  std::shared_ptr<KeyFrame> RestoreKeyFrame(uint64_t id, const Frame& frame)
+      ADEMONO_REQUIRES(mutex);
   std::shared_ptr<MapPoint> RestoreMapPoint(uint64_t id, const Eigen::Vector3d& position,
-                                            KeyFrame* reference, uint64_t frame_id) ADEMONO_REQUIRES(mutex);
+                                            KeyFrame* reference, uint64_t frame_id)
+      ADEMONO_REQUIRES(mutex);
   void SetNextIds(uint64_t next_keyframe_id, uint64_t next_point_id) ADEMONO_REQUIRES(mutex) {
     next_keyframe_id_ = next_keyframe_id;
     next_point_id_ = next_point_id;
@@ -49,7 +53,8 @@ class Map {
   // Marks the point bad, removes its observations and drops it from the map.
   void ErasePoint(MapPoint* point) ADEMONO_REQUIRES(mutex);
   // ORB-SLAM's MapPoint::Replace: `old_point`'s observations move to `new_point`.
-  void ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new_point) ADEMONO_REQUIRES(mutex);
+  void ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new_point)
+      ADEMONO_REQUIRES(mutex);
   // ORB-SLAM's KeyFrame::SetBadFlag: removes the keyframe, its observations and edges and
   // re-parents its children in the spanning tree. The first keyframe is never removed.
   void EraseKeyFrame(KeyFrame* keyframe) ADEMONO_REQUIRES(mutex);
@@ -59,8 +64,12 @@ class Map {
   void Rescale(double factor) ADEMONO_REQUIRES(mutex);
   std::shared_ptr<KeyFrame> GetKeyFrame(uint64_t id) const ADEMONO_REQUIRES(mutex);
   std::shared_ptr<MapPoint> GetMapPoint(uint64_t id) const ADEMONO_REQUIRES(mutex);
-  const std::map<uint64_t, std::shared_ptr<KeyFrame>>& KeyFrames() const ADEMONO_REQUIRES(mutex) { return keyframes_; }
-  const std::map<uint64_t, std::shared_ptr<MapPoint>>& MapPoints() const ADEMONO_REQUIRES(mutex) { return points_; }
+  const std::map<uint64_t, std::shared_ptr<KeyFrame>>& KeyFrames() const ADEMONO_REQUIRES(mutex) {
+    return keyframes_;
+  }
+  const std::map<uint64_t, std::shared_ptr<MapPoint>>& MapPoints() const ADEMONO_REQUIRES(mutex) {
+    return points_;
+  }
   size_t NumKeyFrames() const ADEMONO_REQUIRES(mutex) { return keyframes_.size(); }
   size_t NumMapPoints() const ADEMONO_REQUIRES(mutex) { return points_.size(); }
   uint64_t NextKeyFrameId() const ADEMONO_REQUIRES(mutex) { return next_keyframe_id_; }

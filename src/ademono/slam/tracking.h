@@ -70,7 +70,8 @@ class Tracking {
   // (the geometric test gives the map points made from it the lower static_box_prior); empty:
   // no boxes.
   TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                       double timestamp, std::vector<uint8_t> in_dynamic_box = {}) ADEMONO_REQUIRES(map_.mutex);
+                       double timestamp, std::vector<uint8_t> in_dynamic_box = {})
+      ADEMONO_REQUIRES(map_.mutex);
 
   // After a loop correction moved the keyframes (Map::LoopCorrections changed): the last frame's
   // pose is re-derived from its reference keyframe. Called at every Track() and by System right
