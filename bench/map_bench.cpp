@@ -92,7 +92,7 @@ void BM_MapRestore(benchmark::State& state) {
     ademono::KeyFrameDatabase database;
     ademono::Map map;
     map.SetKeyFrameDatabase(&database);
-    std::lock_guard<std::mutex> lock(map.mutex);
+    ademono::MutexLock lock(map.mutex);
     ademono::RestoreMap(data, pyramid, map);
     benchmark::DoNotOptimize(map.NumMapPoints());
   }

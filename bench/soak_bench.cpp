@@ -12,6 +12,7 @@
 // per-frame jitter, edge errors; depth treated as a prior with scale correction, as with
 // `--depth model:`).
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -44,6 +45,13 @@ double PeakRssMb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // KB on Linux
+}
+
+// Bytes malloc has handed out and not had back: what the program holds, without the allocator's
+// free but unreturned pages (RSS minus this, minus the code, is fragmentation and arenas).
+double HeapInUseMb() {
+  const struct mallinfo2 info = mallinfo2();
+  return static_cast<double>(info.uordblks + info.hblkhd) / (1024.0 * 1024.0);
 }
 
 double CurrentRssMb() {
@@ -96,8 +104,8 @@ void BM_Soak(benchmark::State& state) {
 
   std::fprintf(stderr, "soak %s: %zu frames (back and forth over %zu), 320x240\n",
                kVariantNames[variant], frames, period);
-  std::fprintf(stderr, "%8s %8s %8s %10s %10s %9s %10s\n", "frames", "fps", "lost", "rss_mb",
-               "peak_mb", "keyframes", "map_points");
+  std::fprintf(stderr, "%8s %8s %8s %10s %10s %10s %9s %10s\n", "frames", "fps", "lost",
+               "rss_mb", "peak_mb", "heap_mb", "keyframes", "map_points");
   for (auto _ : state) {
     System system(scene.camera, Options(variant));
     double tracking_seconds = 0;
@@ -123,10 +131,13 @@ void BM_Soak(benchmark::State& state) {
       if ((k + 1) % 1000 == 0 || k + 1 == frames) {
         const size_t window = (k % 1000) + 1;
         const double peak = PeakRssMb();
-        std::fprintf(stderr, "%8zu %8.1f %8d %10.1f %10.1f %9zu %10zu\n", k + 1,
-                     window / tracking_seconds, lost_in_window, CurrentRssMb(), peak,
+        const double heap = HeapInUseMb();
+        std::fprintf(stderr, "%8zu %8.1f %8d %10.1f %10.1f %10.1f %9zu %10zu\n", k + 1,
+                     window / tracking_seconds, lost_in_window, CurrentRssMb(), peak, heap,
                      system.NumKeyFrames(), system.NumMapPoints());
         const size_t done = k + 1;
+        if (done == 1000) state.counters["heap_1k_mb"] = heap;
+        if (done == 10000) state.counters["heap_10k_mb"] = heap;
         if (done == 1000) state.counters["peak_rss_1k_mb"] = peak;
         if (done == 5000) state.counters["peak_rss_5k_mb"] = peak;
         if (done == 10000) state.counters["peak_rss_10k_mb"] = peak;

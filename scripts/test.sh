@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets everything up (scripts/setup.sh), builds, and runs the whole test suite through CTest
 # (C++ GoogleTest suites and the Python tests of tools/). Extra arguments go to the release ctest.
-# Then, always (CI too): the tests of the parsers and of the feature filter under ASan + UBSan
+# Then, always (CI too): clang's thread-safety analysis over the slam sources
+# (tools/thread_safety.sh, -fsyntax-only: about 35 s of CPU); the tests of the parsers and of the feature filter under ASan + UBSan
 # (build/asan, only those three test binaries and the modules they need; docs/reliability.md
 # says why this subset fits CI's 20 minutes and the whole sanitized suite does not).
 # With ADEMONO_RELIABILITY=1, then the longer reliability checks (docs/reliability.md):
@@ -12,6 +13,9 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$here/scripts/setup.sh" --build-type Release
 ctest --test-dir "$here/build/release" --output-on-failure -j "$(nproc)" "$@"
+
+echo "== clang thread-safety analysis of the slam module (the map's lock contract)"
+"$here/tools/thread_safety.sh" "$here/build/release"
 
 echo "== ASan + UBSan: test_core, test_io, test_filter"
 sanitized=(test_core test_io test_filter)

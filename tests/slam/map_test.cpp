@@ -27,7 +27,7 @@ TEST(MapTest, ErasingAKeyFrameThatHoldsTheLastReferenceToAPoint) {
   point.reset();  // kf1 is now the only owner (no weak_ptr: it would keep the memory allocated)
   map.EraseKeyFrame(kf1.get());
   EXPECT_TRUE(kf1->bad);
-  EXPECT_EQ(kf1->map_points[0], nullptr);
+  EXPECT_TRUE(kf1->map_points.empty());
   EXPECT_EQ(map.NumMapPoints(), 0u);
 }
 
@@ -73,6 +73,7 @@ TEST(MapTest, ACulledKeyFrameKeepsItsPoseLinkButNotItsKeypoints) {
   kf1->parent = kf0.get();
   kf0->children.insert(kf1.get());
   ASSERT_EQ(kf1->F().Size(), 2u);
+  ASSERT_EQ(kf1->map_points.size(), 2u);
   Rigid3d cam_from_kf1 = Rigid3d::Identity();
   cam_from_kf1.translation() = Eigen::Vector3d(0, 0.2, 0);
   const Rigid3d before = Map::ResolvePose(kf1.get(), cam_from_kf1);
@@ -80,6 +81,9 @@ TEST(MapTest, ACulledKeyFrameKeepsItsPoseLinkButNotItsKeypoints) {
   ASSERT_TRUE(kf1->bad);
   EXPECT_EQ(kf1->F().Size(), 0u);
   EXPECT_EQ(kf1->F().descriptors.rows, 0);
+  // Nor its map point slots (16 bytes a keypoint, the bulk of a culled keyframe before).
+  EXPECT_EQ(kf1->map_points.capacity(), 0u);
+  EXPECT_EQ(kf1->ordered_connections.capacity(), 0u);
   EXPECT_TRUE(kf1->F().FeaturesInArea(100, 100, 50).empty());
   EXPECT_EQ(kf1->F().intrinsics.fx, features->intrinsics.fx);  // geometry kept
   EXPECT_TRUE(Map::ResolvePose(kf1.get(), cam_from_kf1).isApprox(before, 1e-12));

@@ -28,7 +28,7 @@ BackEnd::BackEnd(const Camera& camera, const SystemOptions& options)
 }
 
 std::vector<LoopEvent> BackEnd::Loops() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   return loop_closing_ ? loop_closing_->Events() : std::vector<LoopEvent>{};
 }
 
@@ -68,9 +68,10 @@ void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
     ThrowInputError(path, "the map's camera (" + CameraText(data.camera) +
                               ") does not match the sequence's (" + CameraText(camera_) + ")");
   }
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   if (map_.NumKeyFrames() != 0) throw std::logic_error("BackEnd::LoadMap: the map is not empty");
   RestoreMap(data, pyramid, map_, path);
+  tracking_.AssertMapHeld();  // tracking's name for the same lock
   tracking_.StartInLoadedMap(localize_only);
 }
 
@@ -78,7 +79,7 @@ void BackEnd::SaveMap(const std::filesystem::path& path) {
   Shutdown();
   MapFileData data;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex);
+    MutexLock lock(map_.mutex);
     data = MapToRecords(map_, camera_, options_);
   }
   SaveMapFile(path, data);
@@ -87,7 +88,7 @@ void BackEnd::SaveMap(const std::filesystem::path& path) {
 void BackEnd::HandOff() { local_mapping_.HandOff(frames_); }
 
 std::optional<Rigid3d> BackEnd::PredictNext() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   return tracking_.PredictNext();
 }
 
@@ -125,7 +126,8 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   const auto start = std::chrono::steady_clock::now();
   TrackingOutput& out = result.tracking;
   {
-    std::lock_guard<std::mutex> lock(map_.mutex);
+    MutexLock lock(map_.mutex);
+    tracking_.AssertMapHeld();
     out = tracking_.Track(filtered.features, frame.index, frame.timestamp, filtered.in_dynamic_box);
     // The one rule for map points on moving objects: occlusion-aware, so it needs this frame's
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
@@ -161,7 +163,8 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
     result.new_keyframe = true;
     local_mapping_.InsertKeyFrame(out.new_keyframe, frame.index);
     // Inserting merges the previous keyframe: a loop closed there moved the world under this frame.
-    std::lock_guard<std::mutex> lock(map_.mutex);
+    MutexLock lock(map_.mutex);
+    tracking_.AssertMapHeld();
     tracking_.FollowLoopCorrection();
     const auto& last = tracking_.LastFrame();
     if (out.tracked && last && last->cam_from_world) out.cam_from_world = *last->cam_from_world;
@@ -173,7 +176,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
 }
 
 Trajectory BackEnd::FrameTrajectory() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   Trajectory trajectory;
   for (const FrameRecord& r : tracking_.Records()) {
     if (!r.tracked || r.reference == nullptr) continue;
@@ -184,7 +187,7 @@ Trajectory BackEnd::FrameTrajectory() const {
 }
 
 std::vector<std::pair<size_t, double>> BackEnd::DepthScales() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   std::vector<std::pair<size_t, double>> scales;
   for (const FrameRecord& r : tracking_.Records()) {
     if (r.tracked) scales.emplace_back(r.index, r.depth_scale);
@@ -193,7 +196,7 @@ std::vector<std::pair<size_t, double>> BackEnd::DepthScales() const {
 }
 
 Trajectory BackEnd::KeyFrameTrajectory() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   Trajectory trajectory;
   for (const auto& [id, kf] : map_.KeyFrames()) {
     trajectory.push_back({kf->timestamp, kf->cam_from_world.inverse()});
@@ -202,7 +205,7 @@ Trajectory BackEnd::KeyFrameTrajectory() const {
 }
 
 std::vector<ColoredPoint> BackEnd::MapPointCloud() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   std::vector<ColoredPoint> cloud;
   for (const auto& [id, p] : map_.MapPoints()) {
     if (p->bad) continue;
@@ -214,12 +217,12 @@ std::vector<ColoredPoint> BackEnd::MapPointCloud() const {
 }
 
 size_t BackEnd::NumKeyFrames() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   return map_.NumKeyFrames();
 }
 
 size_t BackEnd::NumMapPoints() const {
-  std::lock_guard<std::mutex> lock(map_.mutex);
+  MutexLock lock(map_.mutex);
   return map_.NumMapPoints();
 }
 

@@ -80,7 +80,8 @@ class BackEnd {
   // Counts hits of map points landing on moving objects (map_.mutex held) and erases those with
   // tracking.dynamic_cull_hits of them; returns how many were erased.
   int CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::Mat& depth,
-                                 const std::vector<Detection>& moving_boxes);
+                                const std::vector<Detection>& moving_boxes)
+      ADEMONO_REQUIRES(map_.mutex);
 
   Camera camera_;
   SystemOptions options_;

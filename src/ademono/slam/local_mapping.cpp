@@ -52,7 +52,7 @@ void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, siz
   pending->keyframe = keyframe;
   pending->handoff_frame = frame_index + static_cast<size_t>(options_.handoff_frames);
   {
-    std::lock_guard<std::mutex> lock(map_.mutex);
+    MutexLock lock(map_.mutex);
     ProcessNewKeyFrame(*keyframe);
     CullMapPoints(*keyframe);
     if (options_.triangulation) {
@@ -106,11 +106,14 @@ void LocalMapping::Merge() {
   if (pending->failure) std::rethrow_exception(pending->failure);
   const auto start = std::chrono::steady_clock::now();
   {
-    std::lock_guard<std::mutex> lock(map_.mutex);
+    MutexLock lock(map_.mutex);
     if (pending->has_ba) ApplyBundleAdjustment(*pending);
     CullKeyFrames(*pending->keyframe);
     const double cull_ms = MsSinceStart(start);
-    if (loop_closing_ != nullptr && !pending->keyframe->bad) loop_closing_->Process(*pending->keyframe);
+    if (loop_closing_ != nullptr && !pending->keyframe->bad) {
+      loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
+      loop_closing_->Process(*pending->keyframe);
+    }
     spdlog::debug("keyframe {}: apply + cull {:.1f} ms, loop {:.1f} ms", pending->keyframe->id,
                   cull_ms, MsSinceStart(start) - cull_ms);
   }
@@ -361,6 +364,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
 
     std::map<const KeyFrame*, size_t> camera_index;
     auto add_camera = [&](KeyFrame* kf, bool is_fixed) {
+      map_.mutex.AssertHeld();  // the analysis does not carry the lock into a lambda
       camera_index[kf] = problem.cameras.size();
       problem.cameras.push_back({kf->cam_from_world, is_fixed || kf->id == 0});
       cameras.push_back(map_.GetKeyFrame(kf->id));

@@ -77,15 +77,16 @@ class LocalMapping {
   void Solve(Pending& pending) const;
   // Waits for the pending BA, applies it and culls keyframes (map lock taken here).
   void Merge();
-  void ProcessNewKeyFrame(KeyFrame& keyframe);
-  void CullMapPoints(const KeyFrame& keyframe);
+  // The map-editing steps, on the tracking thread under the map lock.
+  void ProcessNewKeyFrame(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
+  void CullMapPoints(const KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
   // Triangulates new map points with the best covisible keyframes; returns how many.
-  int CreateNewMapPoints(KeyFrame& keyframe);
-  void FuseNeighbours(KeyFrame& keyframe);
+  int CreateNewMapPoints(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
+  void FuseNeighbours(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
   // Gathers the local BA around the keyframe (map.mutex held); false: nothing to optimise.
-  bool GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending);
-  void ApplyBundleAdjustment(const Pending& pending);
-  void CullKeyFrames(KeyFrame& keyframe);
+  bool GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) ADEMONO_REQUIRES(map_.mutex);
+  void ApplyBundleAdjustment(const Pending& pending) ADEMONO_REQUIRES(map_.mutex);
+  void CullKeyFrames(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   MappingOptions options_;
@@ -93,7 +94,7 @@ class LocalMapping {
   LoopClosing* loop_closing_ = nullptr;
   std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below
 
-  std::mutex job_mutex_;
+  std::mutex job_mutex_;  // a std::mutex for the condition variable: not annotated
   std::condition_variable job_cv_;
   Pending* job_ = nullptr;  // handed to the mapping thread; guarded by job_mutex_
   bool job_done_ = false;   // guarded by job_mutex_

@@ -258,10 +258,12 @@ bool LoopClosing::Process(KeyFrame& keyframe) {
     for (const auto& [other, w] : kf->connections) place.insert(other->id);
     // Consecutive: this place, or one sharing a keyframe with it, was verified last keyframe.
     int count = 1;
-    for (const auto& [previous, n] : groups_) {
+    for (const auto& group : groups_) {
+      // Not a structured binding: clang 14 (tools/thread_safety.sh) cannot capture one.
+      const std::set<uint64_t>& previous = group.first;
       const bool shared = std::any_of(place.begin(), place.end(),
                                       [&](uint64_t id) { return previous.count(id) > 0; });
-      if (shared) count = std::max(count, n + 1);
+      if (shared) count = std::max(count, group.second + 1);
     }
     groups.emplace_back(std::move(place), count);
     spdlog::debug("loop: keyframe {} (frame {}) verified against {} (frame {}): {} inliers, {} "

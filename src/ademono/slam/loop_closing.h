@@ -51,7 +51,7 @@ class LoopClosing {
               double fuse_radius);
 
   // Detects, verifies and corrects a loop for `keyframe`; true when a loop was closed.
-  bool Process(KeyFrame& keyframe);
+  bool Process(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
   const std::vector<LoopEvent>& Events() const { return events_; }
   bool UsesSim3() const { return sim3_; }
 
@@ -65,10 +65,15 @@ class LoopClosing {
     int matches = 0;
   };
   // Geometric verification of one candidate (steps 2 above); public for tests.
-  std::optional<Verified> Verify(KeyFrame& query, KeyFrame& candidate) const;
+  std::optional<Verified> Verify(KeyFrame& query, KeyFrame& candidate) const
+      ADEMONO_REQUIRES(map_.mutex);
+  // For the analysis (core/thread_annotations.h): the caller holds the map's mutex under another
+  // name. Checked at run time.
+  void AssertMapHeld() const ADEMONO_ASSERT_CAPABILITY(map_.mutex) { map_.mutex.AssertHeld(); }
 
  private:
-  void Correct(KeyFrame& query, const Verified& loop, LoopEvent& event);
+  void Correct(KeyFrame& query, const Verified& loop, LoopEvent& event)
+      ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   const KeyFrameDatabase& database_;

@@ -125,8 +125,12 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
   if (database_ != nullptr) database_->Erase(keyframe->id);
   // Memory grows with the map, not with the frames: a culled keyframe keeps only its pose link
   // (the frames that referenced it still resolve through it), not its keypoints or descriptors.
+  // Nor its per-keypoint map point slots (16 bytes a keypoint: most of what a culled keyframe
+  // still held; a saturated map culls a keyframe every few frames). Its F().Size() is now 0,
+  // so every loop over its keypoints is empty.
   keyframe->features = WithoutKeypoints(keyframe->F());
-  keyframe->map_points.assign(keyframe->map_points.size(), nullptr);
+  std::vector<std::shared_ptr<MapPoint>>().swap(keyframe->map_points);
+  std::vector<KeyFrame*>().swap(keyframe->ordered_connections);
   auto it = keyframes_.find(keyframe->id);
   if (it != keyframes_.end()) {
     graveyard_.push_back(it->second);

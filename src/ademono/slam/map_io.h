@@ -76,7 +76,8 @@ struct MapFileSummary {
 };
 
 // The map as records (the caller holds map.mutex).
-MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptions& options);
+MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptions& options)
+    ADEMONO_REQUIRES(map.mutex);
 // The file bytes (header + payload) and back. ParseMapFile throws InputError "path: problem".
 std::string SerializeMapFile(const MapFileData& data);
 MapFileData ParseMapFile(const std::string& bytes, const std::filesystem::path& path_for_errors);
@@ -90,6 +91,7 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
 // into an empty `map` (its keyframe database is filled too). The caller holds map.mutex.
 // InputError naming `path_for_errors` when a keypoint's level is beyond `pyramid`.
 void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyramid>& pyramid,
-                Map& map, const std::filesystem::path& path_for_errors = {});
+                Map& map, const std::filesystem::path& path_for_errors = {})
+    ADEMONO_REQUIRES(map.mutex);
 
 }  // namespace ademono

@@ -43,7 +43,7 @@ class Matcher {
   // map point is merged with it (the one with fewer observations is replaced), otherwise it gets
   // the new observation. Returns the number of fused points.
   int Fuse(Map& map, KeyFrame& keyframe, const std::vector<std::shared_ptr<MapPoint>>& points,
-           float radius) const;
+           float radius) const ADEMONO_REQUIRES(map.mutex);
 
   // Triangulation (ORB-SLAM's SearchForTriangulation without a vocabulary): keypoints of `k1` and
   // `k2` that have no map point yet, matched by descriptor (best below kOrbDistanceLow, ratio test,

@@ -70,12 +70,13 @@ class Tracking {
   // (the geometric test gives the map points made from it the lower static_box_prior); empty:
   // no boxes.
   TrackingOutput Track(std::shared_ptr<const FrameFeatures> features, size_t index,
-                       double timestamp, std::vector<uint8_t> in_dynamic_box = {});
+                       double timestamp, std::vector<uint8_t> in_dynamic_box = {})
+      ADEMONO_REQUIRES(map_.mutex);
 
   // After a loop correction moved the keyframes (Map::LoopCorrections changed): the last frame's
   // pose is re-derived from its reference keyframe. Called at every Track() and by System right
   // after a keyframe was mapped; a no-op otherwise.
-  void FollowLoopCorrection();
+  void FollowLoopCorrection() ADEMONO_REQUIRES(map_.mutex);
 
   TrackingState State() const { return state_; }
   const std::vector<FrameRecord>& Records() const { return records_; }
@@ -88,39 +89,42 @@ class Tracking {
   // in it (global relocalisation through the keyframe database) instead of initialising a new
   // map, and the loaded map keeps its scale (no anchoring to this session's network). With
   // `localize_only` the map never changes: no keyframe, no point, no point statistics.
-  void StartInLoadedMap(bool localize_only);
+  void StartInLoadedMap(bool localize_only) ADEMONO_REQUIRES(map_.mutex);
   bool LocalizeOnly() const { return localize_only_; }
+  // For the analysis (core/thread_annotations.h): the caller holds the map's mutex under another
+  // name (its own reference to the map). Checked at run time.
+  void AssertMapHeld() const ADEMONO_ASSERT_CAPABILITY(map_.mutex) { map_.mutex.AssertHeld(); }
 
  private:
-  bool Initialise(Frame& frame, const Rigid3d& cam_from_world);
-  bool TrackWithMotionModel(Frame& frame);
-  bool TrackReferenceKeyFrame(Frame& frame);
-  bool TrackLocalMap(Frame& frame);
-  bool Relocalise(Frame& frame);
-  bool NeedNewKeyFrame(const Frame& frame) const;
-  std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame);
+  bool Initialise(Frame& frame, const Rigid3d& cam_from_world) ADEMONO_REQUIRES(map_.mutex);
+  bool TrackWithMotionModel(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  bool TrackReferenceKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  bool TrackLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  bool Relocalise(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  bool NeedNewKeyFrame(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
+  std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   // Motion-only pose optimisation on the matched points with static probability >= min_static
   // (< 0: the geometric test's threshold).
-  int OptimizeFramePose(Frame& frame, double min_static = -1);
-  int DiscardOutliers(Frame& frame);
-  void UpdateLocalMap(Frame& frame);
+  int OptimizeFramePose(Frame& frame, double min_static = -1) ADEMONO_REQUIRES(map_.mutex);
+  int DiscardOutliers(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  void UpdateLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   int CountDepthPoints(const Frame& frame) const;
   // Geometric test: whether a map point's static probability lets it into the pose.
   bool UsableForPose(const MapPoint& point) const;
   // Judges every matched map point at the frame's pose, updates its static probability, marks
   // the ones below the threshold as outliers and culls the ones at the floor. Returns how many
   // are below the threshold.
-  int JudgeStaticness(Frame& frame);
+  int JudgeStaticness(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   // A map point from keypoint i's depth, observed by `keyframe` (made from `frame`).
   void CreatePointFromDepth(Frame& frame, KeyFrame& keyframe, const Rigid3d& world_from_cam,
-                            size_t i, double static_probability);
+                            size_t i, double static_probability) ADEMONO_REQUIRES(map_.mutex);
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
-  void CorrectDepthScale(Frame& frame, bool inliers_only);
+  void CorrectDepthScale(Frame& frame, bool inliers_only) ADEMONO_REQUIRES(map_.mutex);
   // Keeps the map at the network's long-run mean scale (rescales the world when it drifted).
-  void AnchorScale(Frame& frame);
+  void AnchorScale(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   // Multiplies every length of the map and of the tracker's state by `factor`.
-  void RescaleWorld(Frame& frame, double factor);
+  void RescaleWorld(Frame& frame, double factor) ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   const LocalMapping& local_mapping_;

@@ -84,18 +84,35 @@ int AddSprite(Scene& scene, const PhotoCutout& cutout, double height_m) {
   return static_cast<int>(scene.sprites.size()) - 1;
 }
 
+// Walker `id` on `path`: the photo `cutout` as a sprite `height_m` tall, its quad turned by `yaw`
+// from the walking direction; without a cutout, the textured person `look`.
+void AddWalker(Scene& scene, const BackAndForthPath& path, const PersonLook& look, int id,
+               const PhotoCutout* cutout, double height_m, double yaw) {
+  if (cutout == nullptr) {
+    scene.actors.push_back(MakeWalkingPerson(path, look, id));
+    return;
+  }
+  const int sprite = AddSprite(scene, *cutout, height_m);
+  scene.objects[id - 1].appearance = cutout->source;
+  scene.actors.push_back(MakeWalkingSprite(path, yaw, sprite, scene.sprites[sprite].width_m(),
+                                           scene.sprites[sprite].height_m(), id));
+}
+
 // A box of no COCO class carried along `path` (ground z = 0 at `height_m` above it) and
-// turning about `axis` at `spin` rad/s: a mover no detector has a name for.
-ActorFunction MakeTumblingBox(const BackAndForthPath& path, double height_m,
-                              const Eigen::Vector3d& half, const Eigen::Vector3d& axis,
-                              double spin, int texture, int object_id) {
-  return [=](double t, std::vector<Box>& boxes) {
+// turning about `axis` at `spin` rad/s: a mover no detector has a name for. Adds the object
+// `name` (moving, no class) and its actor.
+void AddTumblingBox(Scene& scene, const std::string& name, const BackAndForthPath& path,
+                    double height_m, const Eigen::Vector3d& half, const Eigen::Vector3d& axis,
+                    double spin, int texture) {
+  const int object_id = scene.AddObject(name, -1, true);
+  scene.actors.push_back([=](double t, std::vector<Box>& boxes) {
     Rigid3d pose = path.WorldFromBody(t, nullptr);
     pose.translation().z() += height_m;
-    if (spin != 0.0) pose.linear() = pose.linear() *
-                                     Eigen::AngleAxisd(spin * t, axis.normalized()).toRotationMatrix();
+    if (spin != 0.0)
+      pose.linear() =
+          pose.linear() * Eigen::AngleAxisd(spin * t, axis.normalized()).toRotationMatrix();
     boxes.push_back(MakeBox(pose, half, texture, object_id));
-  };
+  });
 }
 
 void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& scene) {
@@ -158,17 +175,11 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     path.offset_m = rng.Uniform(0, 10.0);
     const PersonLook look = MakePersonLook(textures, rng, rng.Uniform(0.93, 1.05));
     const int id = scene.AddObject("person-" + std::to_string(i + 1), 0, true);
-    if (photos) {
-      // The photo person on the walker's path, its quad along the walking direction (seen
-      // from the front by the camera looking across the paths).
-      const PhotoCutout& cutout = photos->persons[i % photos->persons.size()];
-      const int sprite = AddSprite(scene, cutout, 1.75 * look.scale);
-      scene.objects[id - 1].appearance = cutout.source;
-      scene.actors.push_back(MakeWalkingSprite(path, 0.0, sprite, scene.sprites[sprite].width_m(),
-                                               scene.sprites[sprite].height_m(), id));
-    } else {
-      scene.actors.push_back(MakeWalkingPerson(path, look, id));
-    }
+    // With photos: the photo person on the walker's path, its quad along the walking direction
+    // (seen from the front by the camera looking across the paths).
+    AddWalker(scene, path, look, id,
+              photos ? &photos->persons[i % photos->persons.size()] : nullptr,
+              1.75 * look.scale, 0.0);
   }
   if (photos) {
     // Movers of no COCO class, drawn from their own streams (the rest of the scene unchanged).
@@ -180,20 +191,18 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     cart_path.speed = decoy.Uniform(0.5, 0.8);
     cart_path.offset_m = decoy.Uniform(0, 9.0);
     const Eigen::Vector3d cart_half(0.3, 0.22, 0.35);
-    const int cart = scene.AddObject("cart", -1, true);
-    scene.actors.push_back(MakeTumblingBox(
-        cart_path, cart_half.z(), cart_half, Eigen::Vector3d::UnitZ(), 0.0,
-        decoy_textures.ForBox(TextureStyle::kCarPaint, cart_half, 0.003, RandomTint(decoy)), cart));
+    AddTumblingBox(
+        scene, "cart", cart_path, cart_half.z(), cart_half, Eigen::Vector3d::UnitZ(), 0.0,
+        decoy_textures.ForBox(TextureStyle::kCarPaint, cart_half, 0.003, RandomTint(decoy)));
     BackAndForthPath cube_path;
     cube_path.a = {-2.0, 0.5, 0};
     cube_path.b = {2.0, 0.5 + decoy.Uniform(-0.3, 0.3), 0};
     cube_path.speed = decoy.Uniform(0.4, 0.7);
     cube_path.offset_m = decoy.Uniform(0, 8.0);
     const Eigen::Vector3d cube_half(0.17, 0.17, 0.17);
-    const int cube = scene.AddObject("tumbling-cube", -1, true);
-    scene.actors.push_back(MakeTumblingBox(
-        cube_path, 1.3, cube_half, Eigen::Vector3d(1.0, 0.6, 0.3), 1.5,
-        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.003, RandomTint(decoy)), cube));
+    AddTumblingBox(
+        scene, "tumbling-cube", cube_path, 1.3, cube_half, Eigen::Vector3d(1.0, 0.6, 0.3), 1.5,
+        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.003, RandomTint(decoy)));
   }
 
   MotionSpec motion;
@@ -338,17 +347,10 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     path.speed = 1.3;
     const int id = scene.AddObject("pedestrian", 0, true);
     const PersonLook look = MakePersonLook(textures, rng, 1.0);
-    if (photos) {
-      // Quad across the sidewalk: the camera driving along the road sees the figure's front.
-      const PhotoCutout& cutout = photos->persons[3 % photos->persons.size()];
-      const int sprite = AddSprite(scene, cutout, 1.75);
-      scene.objects[id - 1].appearance = cutout.source;
-      scene.actors.push_back(MakeWalkingSprite(path, M_PI / 2, sprite,
-                                               scene.sprites[sprite].width_m(),
-                                               scene.sprites[sprite].height_m(), id));
-    } else {
-      scene.actors.push_back(MakeWalkingPerson(path, look, id));
-    }
+    // With photos: a quad across the sidewalk (the camera driving along the road sees the
+    // figure's front).
+    AddWalker(scene, path, look, id,
+              photos ? &photos->persons[3 % photos->persons.size()] : nullptr, 1.75, M_PI / 2);
   }
   if (photos) {
     // Movers of no COCO class: a crate wheeled along the left sidewalk towards the camera, and
@@ -360,19 +362,17 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     crate_path.b = {-30, 8.3, 0};
     crate_path.speed = decoy.Uniform(1.2, 1.8);
     const Eigen::Vector3d crate_half(0.45, 0.4, 0.55);
-    const int crate = scene.AddObject("crate", -1, true);
-    scene.actors.push_back(MakeTumblingBox(
-        crate_path, crate_half.z(), crate_half, Eigen::Vector3d::UnitZ(), 0.0,
-        decoy_textures.ForBox(TextureStyle::kWood, crate_half, 0.01, RandomTint(decoy)), crate));
+    AddTumblingBox(
+        scene, "crate", crate_path, crate_half.z(), crate_half, Eigen::Vector3d::UnitZ(), 0.0,
+        decoy_textures.ForBox(TextureStyle::kWood, crate_half, 0.01, RandomTint(decoy)));
     BackAndForthPath cube_path;
     cube_path.a = {decoy.Uniform(20, 35), -4.3, 0};
     cube_path.b = {cube_path.a.x() + 400.0, -4.3, 0};
     cube_path.speed = decoy.Uniform(2.5, 4.0);
     const Eigen::Vector3d cube_half(0.4, 0.4, 0.4);
-    const int cube = scene.AddObject("tumbling-cube", -1, true);
-    scene.actors.push_back(MakeTumblingBox(
-        cube_path, 0.7, cube_half, Eigen::Vector3d(0.2, 1.0, 0.1), 2.0,
-        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.01, RandomTint(decoy)), cube));
+    AddTumblingBox(
+        scene, "tumbling-cube", cube_path, 0.7, cube_half, Eigen::Vector3d(0.2, 1.0, 0.1), 2.0,
+        decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.01, RandomTint(decoy)));
   }
 
   MotionSpec motion;
