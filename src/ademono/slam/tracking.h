@@ -100,8 +100,9 @@ class Tracking {
   bool NeedNewKeyFrame(const Frame& frame) const;
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame);
   // Motion-only pose optimisation on the matched points with static probability >= min_static
-  // (< 0: the geometric test's threshold).
-  int OptimizeFramePose(Frame& frame, double min_static = -1);
+  // (< 0: the geometric test's threshold); `map_points_only`: without localisation-only mode's
+  // odometry points.
+  int OptimizeFramePose(Frame& frame, double min_static = -1, bool map_points_only = false);
   int DiscardOutliers(Frame& frame);
   void UpdateLocalMap(Frame& frame);
   int CountDepthPoints(const Frame& frame) const;
