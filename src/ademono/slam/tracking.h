@@ -104,8 +104,10 @@ class Tracking {
   bool NeedNewKeyFrame(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   // Motion-only pose optimisation on the matched points with static probability >= min_static
-  // (< 0: the geometric test's threshold).
-  int OptimizeFramePose(Frame& frame, double min_static = -1) ADEMONO_REQUIRES(map_.mutex);
+  // (< 0: the geometric test's threshold); `map_points_only`: without localisation-only mode's
+  // odometry points.
+  int OptimizeFramePose(Frame& frame, double min_static = -1, bool map_points_only = false)
+      ADEMONO_REQUIRES(map_.mutex);
   int DiscardOutliers(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   void UpdateLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   int CountDepthPoints(const Frame& frame) const;
