@@ -7,8 +7,14 @@
 #   synchronous   --set mapping.handoff_frames=0 (BA merged before the next frame, old default)
 #   inline        --set mapping.threaded=false (same schedule, BA solved on the tracking thread:
 #                 same outputs as default, shows what the mapping thread buys)
+#   no-prefetch   --no-overlap (decode, extraction and depth on the tracking thread: same outputs
+#                 as default, shows what the prefetch thread buys)
 #   network       FastDepth + YOLOX-nano, default schedule (issue 13 item 5); --no-network skips it
-# "tracking thread" = extraction + filter + tracking medians (decode, depth, detection excluded).
+# A second table gives the stage medians per thread, as summary.json's "timing" labels them
+# (prefetch: decode, depth, detection, ORB extraction and keypoint depths of frame k+1 while
+# frame k is tracked; tracking: filters, tracking, mapping's structure and merges; mapping: the
+# BA solve). "tracking thread" is the tracking thread's own CPU time per frame (median), decode
+# and the on_frame output excluded; "prefetch thread" the same for the prefetch work.
 # Usage: tools/bench_throughput.sh [--out DIR] [--frames A:B] [--no-network] [-- RUN_ARGS...]
 # Measure on an idle machine: other jobs inflate every figure.
 set -euo pipefail
@@ -38,10 +44,11 @@ run_case() {
   "$bin" run --overwrite "${common[@]}" "$@" "${extra[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 ||
     { echo "bench_throughput: case $name failed, see $out/$name.log" >&2; exit 1; }
 }
-cases=(default synchronous inline)
+cases=(default synchronous inline no-prefetch)
 run_case default
 run_case synchronous --set mapping.handoff_frames=0
 run_case inline --set mapping.threaded=false
+run_case no-prefetch --no-overlap
 if [ "$network" = 1 ]; then
   run_case network \
     --depth "model:$models/fastdepth_nyu_320.onnx,spec=$here/configs/models/fastdepth_nyu.yaml" \
@@ -51,16 +58,25 @@ fi
 python3 - "$out" "${cases[@]}" <<'PY'
 import json, sys
 out, cases = sys.argv[1], sys.argv[2:]
-print("| case | frames/s (wall) | wall s | tracked | keyframes | ATE se3 (m) | extraction | filter | tracking | tracking thread | depth | detection | local mapping p95 |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-for c in cases:
-    s = json.load(open(f"{out}/{c}/summary.json"))
+runs = {c: json.load(open(f"{out}/{c}/summary.json")) for c in cases}
+print("| case | frames/s (wall) | wall s | tracked | keyframes | ATE se3 (m) | tracking thread CPU median (ms) | prefetch thread CPU median (ms) | local mapping p95 (ms) |")
+print("|---|---|---|---|---|---|---|---|---|")
+for c, s in runs.items():
     t = s["timing"]
-    med = lambda k: t[k]["median_ms"]
-    thread = med("extraction") + med("filter") + med("tracking")
     ate = s.get("accuracy", {}).get("ate_se3_rmse_m")
     print(f"| {c} | {s['fps']:.1f} | {s['wall_seconds']:.1f} | {s['tracked']}/{s['frames']} | "
-          f"{s['keyframes']} | {ate if ate is None else f'{ate:.4f}'} | {med('extraction'):.1f} | {med('filter'):.2f} | "
-          f"{med('tracking'):.1f} | {thread:.1f} | {med('depth'):.1f} | {med('detection'):.1f} | "
+          f"{s['keyframes']} | {ate if ate is None else f'{ate:.4f}'} | "
+          f"{t['tracking_thread']['median_ms']:.1f} | {t['prefetch_thread']['median_ms']:.1f} | "
           f"{t['local_mapping']['p95_ms']:.0f} |")
+print()
+stages = ["decode", "depth", "detection", "extraction", "keypoint_depth", "filter", "tracking",
+          "prefetch_wait", "local_mapping"]
+print("Stage medians, wall ms (thread in brackets):")
+print()
+print("| case | " + " | ".join(stages) + " |")
+print("|---|" + "---|" * len(stages))
+for c, s in runs.items():
+    t = s["timing"]
+    cells = [f"{t[k]['median_ms']:.2f} ({t[k]['thread']})" for k in stages]
+    print(f"| {c} | " + " | ".join(cells) + " |")
 PY

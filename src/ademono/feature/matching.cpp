@@ -82,6 +82,8 @@ int DescriptorDistance(const cv::Mat& a, const cv::Mat& b) {
   return Distance(a.ptr<uchar>(), b.ptr<uchar>());
 }
 
+int DescriptorDistance(const uchar* a, const uchar* b) { return Distance(a, b); }
+
 RotationHistogram::RotationHistogram(int num_bins) {
   if (num_bins < 1) throw std::invalid_argument("RotationHistogram: num_bins must be >= 1");
   bins_.resize(num_bins);

@@ -51,5 +51,7 @@ class OrbExtractor {
 
 // Hamming distance between two 32-byte descriptors (rows of CV_8U).
 int DescriptorDistance(const cv::Mat& a, const cv::Mat& b);
+// The same on two raw 32-byte rows (no cv::Mat headers in hot loops).
+int DescriptorDistance(const uchar* a, const uchar* b);
 
 }  // namespace ademono

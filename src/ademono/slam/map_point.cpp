@@ -29,22 +29,26 @@ void MapPoint::EraseObservation(KeyFrame* keyframe) {
 }
 
 void MapPoint::ComputeDistinctiveDescriptor() {
-  std::vector<cv::Mat> descriptors;
+  // Raw row pointers and one flat distance table: this runs for every point a keyframe touches,
+  // and cv::Mat row headers and per-row vectors dominated its cost.
+  std::vector<const uchar*> rows;
+  rows.reserve(observations.size());
   for (const auto& [kf, idx] : observations) {
-    if (!kf->bad) descriptors.push_back(kf->F().descriptors.row(static_cast<int>(idx)));
+    if (!kf->bad) rows.push_back(kf->F().descriptors.ptr<uchar>(static_cast<int>(idx)));
   }
-  if (descriptors.empty()) return;
-  const size_t n = descriptors.size();
-  std::vector<std::vector<int>> distances(n, std::vector<int>(n, 0));
+  if (rows.empty()) return;
+  const size_t n = rows.size();
+  std::vector<int> distances(n * n, 0);
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
-      distances[i][j] = distances[j][i] = DescriptorDistance(descriptors[i], descriptors[j]);
+      distances[i * n + j] = distances[j * n + i] = DescriptorDistance(rows[i], rows[j]);
     }
   }
   int best_median = INT32_MAX;
   size_t best = 0;
+  std::vector<int> row(n);
   for (size_t i = 0; i < n; ++i) {
-    std::vector<int> row = distances[i];
+    std::copy(distances.begin() + i * n, distances.begin() + (i + 1) * n, row.begin());
     std::nth_element(row.begin(), row.begin() + (n - 1) / 2, row.end());
     const int median = row[(n - 1) / 2];
     if (median < best_median) {
@@ -52,7 +56,8 @@ void MapPoint::ComputeDistinctiveDescriptor() {
       best = i;
     }
   }
-  descriptor = descriptors[best].clone();
+  descriptor = cv::Mat(1, 32, CV_8UC1);
+  std::copy(rows[best], rows[best] + 32, descriptor.ptr<uchar>());
 }
 
 void MapPoint::UpdateNormalAndDepth() {
