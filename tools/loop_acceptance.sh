@@ -2,10 +2,12 @@
 # Loop-closing acceptance (docs/loops.md): synthetic loops (office, street) with the simulated
 # network's scale drift, loop closing on and off (ATE se3 / sim3 against exact ground truth), and
 # sequences that never revisit a place (office forward, street forward) over three seeds, which
-# must close no loop. Prints a markdown table. Usage:
+# must close no loop, and 7-Scenes seq-a (sensor depth, default config) with the same seeds.
+# Prints a markdown table. Usage:
 #   tools/loop_acceptance.sh [WORKDIR]     (default /tmp/ademono_loops; sequences are reused)
 # Env: ADEMONO (the CLI, default build/release/bin/ademono), OFFICE_FRAMES (600),
-# STREET_FRAMES (300), FORWARD_FRAMES (150), SEEDS ("1 2 3").
+# STREET_FRAMES (300), FORWARD_FRAMES (150), SEEDS ("1 2 3"), SEQ_A (../shared/data/7scenes-seq-a;
+# empty: skipped).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ADEMONO:-build/release/bin/ademono}
@@ -14,6 +16,7 @@ OFFICE_FRAMES=${OFFICE_FRAMES:-600}
 STREET_FRAMES=${STREET_FRAMES:-300}
 FORWARD_FRAMES=${FORWARD_FRAMES:-150}
 SEEDS=${SEEDS:-1 2 3}
+SEQ_A=${SEQ_A-../shared/data/7scenes-seq-a}
 mkdir -p "$W"
 
 synth() {  # name scene motion frames seed
@@ -71,3 +74,11 @@ for seed in $SEEDS; do
     row "$scene forward seed $seed (no revisit)" "$W/run_${scene}_forward_$seed/summary.json"
   done
 done
+if [ -n "$SEQ_A" ]; then
+  for seed in $SEEDS; do
+    out="$W/run_seq_a_$seed"
+    rm -rf "$out"
+    "$B" run --overwrite --dataset "7scenes:$SEQ_A" --seed "$seed" --out "$out" >"$out.log" 2>&1
+    row "7-Scenes seq-a seed $seed" "$out/summary.json"
+  done
+fi

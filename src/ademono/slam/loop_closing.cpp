@@ -333,6 +333,15 @@ void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& even
   // 2. Fusion: the loop's points replace the query's duplicates; the loop side's points are
   // fused into every connected keyframe.
   std::set<KeyFrame*, KeyFrameIdLess> neighbours_before(connected.begin(), connected.end());
+  // Each connected keyframe's own covisible keyframes before the fusion: links to them are not
+  // loop edges (ORB-SLAM removes them too). Counted as loop edges they were measured between a
+  // corrected and an uncorrected pose and pulled the corrected side back towards the drift
+  // (the keyframes just before the loop ended up worse than without closure).
+  std::map<const KeyFrame*, std::set<const KeyFrame*>, KeyFrameIdLess> previous_neighbours;
+  for (KeyFrame* kf : connected) {
+    auto& set = previous_neighbours[kf];
+    for (const auto& [other, w] : kf->connections) set.insert(other);
+  }
   for (size_t i = 0; i < loop.matched.size(); ++i) {
     const std::shared_ptr<MapPoint> loop_point = MapPoint::Resolve(loop.matched[i]);
     if (!loop_point || loop_point->bad) continue;
@@ -374,7 +383,8 @@ void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& even
     if (kf->bad) continue;
     kf->UpdateConnections();
     for (const auto& [other, w] : kf->connections) {
-      if (!neighbours_before.count(other) && !other->bad)
+      if (!neighbours_before.count(other) && !previous_neighbours[kf].count(other) &&
+          !other->bad)
         loop_edges_.emplace_back(std::min(kf->id, other->id), std::max(kf->id, other->id));
     }
   }
