@@ -597,6 +597,7 @@ int Tracking::JudgeStaticness(Frame& frame) {
     const Eigen::Vector3d cam = *frame.cam_from_world * p->position;
     double residual = std::numeric_limits<double>::infinity();
     std::optional<double> depth_error;
+    double depth_sigma = 0.0;
     if (cam.z() > 0) {
       const cv::KeyPoint& kp = f.keypoints_un[i];
       const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
@@ -604,10 +605,13 @@ int Tracking::JudgeStaticness(Frame& frame) {
       // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
       const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
       residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
-      if (f.depth[i] > 0) depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+      if (f.depth[i] > 0) {
+        depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+        if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
+      }
     }
     p->static_probability = UpdateStaticProbability(
-        p->static_probability, JudgeObservation(residual, depth_error, params));
+        p->static_probability, JudgeObservation(residual, depth_error, params, depth_sigma));
     if (UsableForPose(*p)) continue;
     ++dynamic;
     frame.outlier[i] = true;
