@@ -31,6 +31,24 @@ TEST(StaticProbabilityTest, JudgesResidualAndDepth) {
             StaticEvidence::kDynamic);
 }
 
+TEST(StaticProbabilityTest, DepthWithAnErrorModelIsJudgedAgainstItsSigma) {
+  StaticTestParams p;
+  p.depth_sigmas = 0.5;
+  p.depth_dynamic_sigmas = 1.0;
+  // A network depth with sigma_z / z = 0.4: 30 % disagreement is motion for a sensor but within
+  // the network's error (static band 0.2, dynamic band 0.4) it is no verdict ...
+  EXPECT_EQ(JudgeObservation(1.0, 0.3, p), StaticEvidence::kDynamic);
+  EXPECT_EQ(JudgeObservation(1.0, 0.3, p, 0.4), StaticEvidence::kNone);
+  EXPECT_EQ(JudgeObservation(1.0, 0.15, p, 0.4), StaticEvidence::kStatic);
+  // ... while a disagreement beyond it is still motion, and the reprojection residual decides as
+  // before.
+  EXPECT_EQ(JudgeObservation(1.0, 0.5, p, 0.4), StaticEvidence::kDynamic);
+  EXPECT_EQ(JudgeObservation(10.0, 0.01, p, 0.4), StaticEvidence::kDynamic);
+  // A small sigma never narrows the sensor bands.
+  EXPECT_EQ(JudgeObservation(1.0, 0.04, p, 0.01), StaticEvidence::kStatic);
+  EXPECT_EQ(JudgeObservation(1.0, 0.1, p, 0.01), StaticEvidence::kNone);
+}
+
 TEST(StaticProbabilityTest, MotionOutweighsAgreementAndStaysReversible) {
   double p = 0.45;
   p = UpdateStaticProbability(p, StaticEvidence::kStatic);

@@ -17,19 +17,25 @@ const OptionsTable<StaticTestParams>& StaticTestParams::Table() {
           .Add("static_residual_px", &P::residual_px, Range::Above(0))
           .Add("static_residual_dynamic_px", &P::residual_dynamic_px, Range::Above(0))
           .Add("static_depth_relative", &P::depth_relative, Range::Above(0))
-          .Add("static_depth_dynamic_relative", &P::depth_dynamic_relative, Range::Above(0));
+          .Add("static_depth_dynamic_relative", &P::depth_dynamic_relative, Range::Above(0))
+          .Add("static_depth_sigmas", &P::depth_sigmas, Range::Above(0))
+          .Add("static_depth_dynamic_sigmas", &P::depth_dynamic_sigmas, Range::Above(0));
   return table;
 }
 
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
-                                const StaticTestParams& params) {
+                                const StaticTestParams& params, double depth_relative_sigma) {
   if (!std::isfinite(residual_px)) return StaticEvidence::kDynamic;
   const bool depth_known = depth_relative_error && std::isfinite(*depth_relative_error);
+  const double sigma = std::isfinite(depth_relative_sigma) ? std::max(depth_relative_sigma, 0.0) : 0.0;
+  const double static_band = std::max(params.depth_relative, params.depth_sigmas * sigma);
+  const double dynamic_band =
+      std::max(params.depth_dynamic_relative, params.depth_dynamic_sigmas * sigma);
   if (residual_px > params.residual_dynamic_px ||
-      (depth_known && *depth_relative_error > params.depth_dynamic_relative))
+      (depth_known && *depth_relative_error > dynamic_band))
     return StaticEvidence::kDynamic;
   if (residual_px <= params.residual_px &&
-      (!depth_known || *depth_relative_error <= params.depth_relative))
+      (!depth_known || *depth_relative_error <= static_band))
     return StaticEvidence::kStatic;
   return StaticEvidence::kNone;
 }

@@ -23,6 +23,11 @@ struct StaticTestParams {
   double residual_dynamic_px = 6.0;  // above: evidence of motion
   double depth_relative = 0.05;  // |z_map - z_measured| / z_measured below: static evidence ...
   double depth_dynamic_relative = 0.15;  // ... above: evidence of motion
+  // A depth with an error model (network depth) is judged against its own sigma: the two bands
+  // above widen to depth_sigmas and depth_dynamic_sigmas times sigma_z / z when that is wider
+  // (a learned depth's 15-50 % error would otherwise read every static point as moving).
+  double depth_sigmas = 0.5;
+  double depth_dynamic_sigmas = 1.0;
 
   // Its keys of the flat `tracking:` node (static_prior, ...; TrackingOptions holds them).
   static const OptionsTable<StaticTestParams>& Table();
@@ -34,8 +39,10 @@ enum class StaticEvidence { kNone, kStatic, kDynamic };
 // The verdict of one observation: `residual_px` the reprojection residual at the frame's pose in
 // level-0 pixels, `depth_relative_error` |z_map - z_measured| / z_measured when the keypoint has a
 // depth. Motion in either is evidence of motion; static needs both (when depth is known) agreeing.
+// `depth_relative_sigma` is the depth's error model sigma_z / z at the measured depth (0: a
+// sensor, judged by the fixed bands alone).
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
-                                const StaticTestParams& params);
+                                const StaticTestParams& params, double depth_relative_sigma = 0.0);
 
 // Bayes update of P(static) by one verdict (likelihood ratios 1.5 for static, 1/4 for motion),
 // clamped to [0.02, 0.98] so that a point can always change its mind.

@@ -205,8 +205,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     }
 
     if (ok) {
-      if (out.quality == PoseQuality::kMotionModel) {
-        // velocity_ stays: the prediction is all this frame has.
+      if (weak) {
+        // velocity_ stays: a weak pose (the prediction, or a pose on a few points in a crowd)
+        // must not teach the motion model a jump that the next weak frames would then repeat
+        // (bonn-crowd-a with FastDepth: 0.4-0.9 m excursions within 10 frames).
       } else if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else {
@@ -634,6 +636,7 @@ int Tracking::JudgeStaticness(Frame& frame) {
     const Eigen::Vector3d cam = *frame.cam_from_world * p->position;
     double residual = std::numeric_limits<double>::infinity();
     std::optional<double> depth_error;
+    double depth_sigma = 0.0;
     if (cam.z() > 0) {
       const cv::KeyPoint& kp = f.keypoints_un[i];
       const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
@@ -641,10 +644,13 @@ int Tracking::JudgeStaticness(Frame& frame) {
       // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
       const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
       residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
-      if (f.depth[i] > 0) depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+      if (f.depth[i] > 0) {
+        depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+        if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
+      }
     }
     p->static_probability = UpdateStaticProbability(
-        p->static_probability, JudgeObservation(residual, depth_error, params));
+        p->static_probability, JudgeObservation(residual, depth_error, params, depth_sigma));
     if (UsableForPose(*p)) continue;
     ++dynamic;
     frame.outlier[i] = true;
