@@ -74,7 +74,8 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("static_test", &T::static_test)
           .AddFlat(&T::static_params, StaticTestParams::Table())
           .Add("weak_pose_max_frames", &T::weak_pose_max_frames, Range::AtLeast(0))
-          .Add("weak_pose_min_inliers", &T::weak_pose_min_inliers, Range::AtLeast(3));
+          .Add("weak_pose_min_inliers", &T::weak_pose_min_inliers, Range::AtLeast(3))
+          .Add("weak_pose_sets_velocity", &T::weak_pose_sets_velocity);
   return table;
 }
 

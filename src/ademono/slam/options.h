@@ -105,6 +105,11 @@ struct TrackingOptions {
   // constant-velocity prediction. Weak frames make no keyframe. 0 disables.
   int weak_pose_max_frames = 30;
   int weak_pose_min_inliers = 10;
+  // Whether a pose on a few static points sets the constant velocity. With sensor depth it
+  // should: it is the best guess of the motion through a crowd. With network depth a pose on
+  // ten-odd points inherits their depth errors, and a jump it teaches is repeated by the next
+  // weak frames (bonn-crowd-a, FastDepth: 0.4-0.9 m excursions within 10 frames).
+  bool weak_pose_sets_velocity = true;
   void Check() const;
   static TrackingOptions FromYaml(const YAML::Node& node);
   YAML::Node ToYaml() const;

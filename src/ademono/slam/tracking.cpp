@@ -205,10 +205,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     }
 
     if (ok) {
-      if (weak) {
-        // velocity_ stays: a weak pose (the prediction, or a pose on a few points in a crowd)
-        // must not teach the motion model a jump that the next weak frames would then repeat
-        // (bonn-crowd-a with FastDepth: 0.4-0.9 m excursions within 10 frames).
+      if (out.quality == PoseQuality::kMotionModel ||
+          (weak && !options_.tracking.weak_pose_sets_velocity)) {
+        // velocity_ stays: the prediction is all this frame has, or (network depth) a pose on a
+        // few points must not teach the motion model a jump that the next weak frames repeat.
       } else if (last_frame_ && last_frame_->cam_from_world && state_ == TrackingState::kOk) {
         velocity_ = *frame.cam_from_world * last_frame_->cam_from_world->inverse();
       } else {
