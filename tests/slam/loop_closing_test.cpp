@@ -84,8 +84,10 @@ synth::SceneOptions OfficeLoop(size_t frames) {
 
 TEST(LoopClosingTest, OfficeLoopIsClosedAndReducesTheError) {
   const size_t frames = 240;
-  const LoopRun closed = RunScene(OfficeLoop(frames), NetworkOptions(true), 3);
-  const LoopRun open = RunScene(OfficeLoop(frames), NetworkOptions(false), 3);
+  SystemOptions on = NetworkOptions(true), off = NetworkOptions(false);
+  on.tracking.static_test = off.tracking.static_test = false;
+  const LoopRun closed = RunScene(OfficeLoop(frames), on, 3);
+  const LoopRun open = RunScene(OfficeLoop(frames), off, 3);
   EXPECT_EQ(closed.tracked, static_cast<int>(frames));
   EXPECT_TRUE(open.loops.empty());
   ASSERT_FALSE(closed.loops.empty());
@@ -96,12 +98,13 @@ TEST(LoopClosingTest, OfficeLoopIsClosedAndReducesTheError) {
   EXPECT_TRUE(loop.sim3);  // network depth: its scale drifts
   EXPECT_GT(loop.correction_m, 0.0);
   EXPECT_GE(loop.matches, 40);
-  // Measured with the defaults (geometric test on): 0.0788 -> 0.0546 m (0.69x); with the test
-  // off 0.228 -> 0.062 m (0.27x). Before the loop edges were limited to links across the loop
-  // the closure made the keyframes just before the loop worse (0.0788 -> 0.0746 m; test off
-  // 0.137 m), docs/loops.md.
-  EXPECT_LE(closed.ate_sim3, 0.06) << "closed " << closed.ate_sim3 << " open " << open.ate_sim3;
-  EXPECT_LE(closed.ate_sim3, 0.75 * open.ate_sim3)
+  // The geometric test off, as configs/network_indoor.yaml ships it for network depth. Measured
+  // 0.228 -> 0.062 m (0.27x). With the test on the open lap is already better (0.062 m since the
+  // test judges depth by its error model) and the closure gains less (0.057 m, 0.91x); the
+  // 600-frame office and 300-frame street laps of tools/loop_acceptance.sh give 0.26x and 0.46x
+  // (docs/loops.md).
+  EXPECT_LE(closed.ate_sim3, 0.07) << "closed " << closed.ate_sim3 << " open " << open.ate_sim3;
+  EXPECT_LE(closed.ate_sim3, 0.5 * open.ate_sim3)
       << "closed " << closed.ate_sim3 << " open " << open.ate_sim3;
 }
 
