@@ -16,32 +16,49 @@ struct Prepared {
   std::vector<Detection> detections;
   ExtractedFrame extracted;
   double decode_ms = 0, depth_ms = 0, detection_ms = 0;
-  double cpu_ms = 0;  // CPU of the thread(s) that prepared it
+  double cpu_ms = 0;  // CPU of the thread(s) that prepared it, decode included
+  double decode_cpu_ms = 0;
 };
 
 // Depth, detections, ORB features and keypoint depths of a loaded frame. With `parallel`, the ORB
-// extraction (which needs only the image) runs on its own thread beside the depth network and the
-// detector; either way the result is the same.
+// extraction (which needs only the image) runs on its own thread beside the depth network, and so
+// does the detector when there is a depth network too (the method's three parallel branches: two
+// single-threaded ONNX sessions on two cores); either way the result is the same.
 void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth,
                    Detector* detector, const System& system, bool parallel) {
   const double cpu_start = ThreadCpuMs();
   std::future<std::pair<ExtractedFrame, double>> features;
+  std::future<double> detected;  // CPU ms; fills p.detections and p.detection_ms
+  auto detect = [detector, &p] {
+    const double cpu = ThreadCpuMs();
+    const auto start = Now();
+    p.detections = detector->Detect(p.frame);
+    p.detection_ms = MsSince(start);
+    return ThreadCpuMs() - cpu;
+  };
   if (parallel) {
     features = std::async(std::launch::async, [&system, &p] {
       const double cpu = ThreadCpuMs();
       ExtractedFrame e = system.ExtractFeatures(p.frame);
       return std::make_pair(std::move(e), ThreadCpuMs() - cpu);
     });
+    if (detector != nullptr && depth != nullptr && depth->Name() != "sensor")
+      detected = std::async(std::launch::async, detect);
   }
+  double detection_cpu = 0;
   try {
-    auto start = Now();
+    const auto start = Now();
     if (depth != nullptr) p.depth = depth->Depth(p.frame, sequence.GetCamera());
     p.depth_ms = MsSince(start);
-    start = Now();
-    if (detector != nullptr) p.detections = detector->Detect(p.frame);
-    p.detection_ms = MsSince(start);
+    if (detected.valid()) {
+      detection_cpu = detected.get();
+    } else if (detector != nullptr) {
+      detect();
+    }
   } catch (...) {
-    if (features.valid()) features.wait();  // it reads p.frame
+    // Both read p.frame and write p: neither may outlive this call.
+    if (detected.valid()) detected.wait();
+    if (features.valid()) features.wait();
     throw;
   }
   double extraction_cpu = 0;
@@ -51,7 +68,7 @@ void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth,
     p.extracted = system.ExtractFeatures(p.frame);
   }
   system.AddDepths(p.extracted, p.depth);
-  p.cpu_ms += ThreadCpuMs() - cpu_start + extraction_cpu;
+  p.cpu_ms += ThreadCpuMs() - cpu_start + extraction_cpu + detection_cpu;
 }
 
 Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector,
@@ -61,7 +78,7 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
   const auto start = Now();
   p.frame = sequence.Load(i);
   p.decode_ms = MsSince(start);
-  p.cpu_ms = ThreadCpuMs() - cpu_start;
+  p.cpu_ms = p.decode_cpu_ms = ThreadCpuMs() - cpu_start;
   PrepareLoaded(p, sequence, depth, detector, system, parallel);
   return p;
 }
@@ -137,7 +154,7 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
         wait_ms = MsSince(wait_start);
       } else {
         current = Prepare(sequence, depth, detector, system, false, i);
-        inline_cpu = current.cpu_ms;
+        inline_cpu = current.cpu_ms - current.decode_cpu_ms;  // the tracking thread: decode excluded
       }
       if (options.overlap && i + 1 < end) {
         next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector,

@@ -39,8 +39,9 @@ struct PipelineOptions {
 
 // Wall milliseconds per stage of one frame, except tracking_thread_ms and prefetch_thread_ms:
 // CPU milliseconds of the tracking (calling) thread for this frame (everything the loop does for
-// it there except the on_frame callback: filters, tracking, mapping's work on that thread, and
-// decode/extraction too without overlap) and of the prefetch work for it (0 without overlap).
+// it there except the on_frame callback and the image decode: filters, tracking, mapping's work
+// on that thread, and extraction, depth and detection too without overlap) and of the prefetch
+// work for it, decode included (0 without overlap).
 struct FrameTiming {
   double decode_ms = 0, extraction_ms = 0, keypoint_depth_ms = 0, depth_ms = 0, detection_ms = 0,
          filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
@@ -54,7 +55,7 @@ struct PipelineResult {
   size_t frames = 0;
   double wall_seconds = 0;
   bool stopped = false;  // options.stop ended the loop before the last frame
-  bool prefetched = false;  // decode, depth, detection and extraction ran on the prefetch thread
+  bool prefetched = false;  // decode, depth, detection and extraction ran on the prefetch threads
 };
 
 // Throws InputError from the sequence or the providers (e.g. a missing cached depth map).
