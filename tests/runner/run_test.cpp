@@ -203,8 +203,10 @@ TEST_F(RunnerTest, SecondAndSequentialRunWritesIdenticalOutputs) {
   // Without prefetch every stage but the BA solve runs on the tracking thread.
   EXPECT_EQ(second.timing.at("extraction").thread, "tracking");
   EXPECT_EQ(second.timing.at("prefetch_thread").median_ms, 0.0);
-  EXPECT_GT(second.timing.at("tracking_thread").median_ms,
-            second.timing.at("extraction").median_ms * 0.5);  // CPU, includes extraction
+  // CPU time, measured (extraction included); not compared with the wall-time stages, which a
+  // loaded machine inflates (CI at load 25: 12.7 ms of CPU against 22.4 ms of wall extraction).
+  EXPECT_GT(second.timing.at("tracking_thread").median_ms, 0.0);
+  EXPECT_EQ(second.timing.at("tracking_thread").thread, "tracking");
   WriteRunOutputs(second, sequential);
   for (const char* file :
        {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "groundtruth.tum"}) {
