@@ -5,6 +5,7 @@
 # must close no loop, and 7-Scenes seq-a (sensor depth, default config) with the same seeds.
 # Prints a markdown table. Usage:
 #   tools/loop_acceptance.sh [WORKDIR]     (default /tmp/ademono_loops; sequences are reused)
+# With the loop closed it also runs loop.global_ba=true twice (the repeat must be byte-identical).
 # Env: ADEMONO (the CLI, default build/release/bin/ademono), OFFICE_FRAMES (600),
 # STREET_FRAMES (300), FORWARD_FRAMES (150), SEEDS ("1 2 3"), SEQ_A (../shared/data/7scenes-seq-a;
 # empty: skipped).
@@ -26,8 +27,8 @@ synth() {  # name scene motion frames seed
   echo "$out"
 }
 
-run() {  # seq scene loop_enabled out
-  local seq=$1 scene=$2 loop=$3 out=$4 depth config
+run() {  # seq scene loop_enabled out [global_ba]
+  local seq=$1 scene=$2 loop=$3 out=$4 gba=${5:-false} depth config
   if [ "$scene" = street ]; then
     config=configs/network_outdoor.yaml
     depth="simulated:gt=$seq/depth_full,scale=0.88,jitter=0.16,jitter_frames=200"
@@ -37,7 +38,7 @@ run() {  # seq scene loop_enabled out
   fi
   rm -rf "$out"
   "$B" run --overwrite --dataset "tum:$seq" --config "$config" --depth "$depth" \
-    --detector "cache:$seq/detections.jsonl" --set "loop.enabled=$loop" --out "$out" \
+    --detector "cache:$seq/detections.jsonl" --set "loop.enabled=$loop" --set "loop.global_ba=$gba" --out "$out" \
     >"$out.log" 2>&1
 }
 
@@ -66,6 +67,13 @@ for scene in office street; do
     run "$seq" "$scene" "$loop" "$W/run_${scene}_loop_$loop"
     row "$scene loop, loop.enabled=$loop" "$W/run_${scene}_loop_$loop/summary.json"
   done
+  # The optional global BA after the loop, run twice: the trajectories must be byte-identical.
+  for rep in a b; do run "$seq" "$scene" true "$W/run_${scene}_loop_gba_$rep" true; done
+  same=no
+  cmp -s "$W/run_${scene}_loop_gba_a/trajectory.tum" "$W/run_${scene}_loop_gba_b/trajectory.tum" &&
+    same=yes
+  row "$scene loop, loop.global_ba=true (repeat byte-identical: $same)" \
+    "$W/run_${scene}_loop_gba_a/summary.json"
 done
 for seed in $SEEDS; do
   for scene in office street; do

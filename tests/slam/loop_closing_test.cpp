@@ -108,6 +108,39 @@ TEST(LoopClosingTest, OfficeLoopIsClosedAndReducesTheError) {
       << "closed " << closed.ate_sim3 << " open " << open.ate_sim3;
 }
 
+TEST(LoopClosingTest, GlobalBundleAdjustmentAfterTheLoopIsMergedDeterministically) {
+  // loop.global_ba: solved on its own thread from a snapshot, merged at a fixed keyframe. Two runs
+  // give the same trajectory to the bit, and the lap is no worse than with the loop correction
+  // alone.
+  const size_t frames = 240;
+  SystemOptions plain = NetworkOptions(true);
+  plain.tracking.static_test = false;
+  SystemOptions gba = plain;
+  gba.loop.global_ba = true;
+  const LoopRun first = RunScene(OfficeLoop(frames), gba, 3);
+  const LoopRun second = RunScene(OfficeLoop(frames), gba, 3);
+  const LoopRun without = RunScene(OfficeLoop(frames), plain, 3);
+  ASSERT_FALSE(first.loops.empty());
+  const LoopEvent& loop = first.loops.front();
+  EXPECT_TRUE(loop.global_ba);
+  EXPECT_TRUE(loop.global_ba_merged);
+  EXPECT_GT(loop.global_ba_keyframes, 10u);
+  EXPECT_GT(loop.global_ba_points, 1000u);
+  // At a later keyframe's processing, or at the end (the last keyframe's id).
+  EXPECT_GE(loop.global_ba_merged_at_keyframe, loop.query_keyframe);
+  EXPECT_FALSE(without.loops.front().global_ba);
+  ASSERT_EQ(first.estimate.size(), second.estimate.size());
+  for (size_t i = 0; i < first.estimate.size(); ++i) {
+    ASSERT_EQ(first.estimate[i].timestamp, second.estimate[i].timestamp);
+    ASSERT_TRUE(first.estimate[i].world_from_cam.matrix() ==
+                second.estimate[i].world_from_cam.matrix())
+        << "frame " << i;
+  }
+  EXPECT_EQ(first.ate_sim3, second.ate_sim3);
+  EXPECT_LE(first.ate_sim3, without.ate_sim3 + 0.005)
+      << "global BA " << first.ate_sim3 << " loop correction alone " << without.ate_sim3;
+}
+
 TEST(LoopClosingTest, NoLoopWithoutARevisit) {
   // Forward through the office (never back) and the street driving on: no place is seen twice.
   synth::SceneOptions office;

@@ -337,7 +337,13 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                      {"correction_deg", e.correction_deg},
                      {"graph_keyframes", e.graph_keyframes},
                      {"graph_edges", e.graph_edges},
-                     {"ms", e.milliseconds}});
+                     {"ms", e.milliseconds},
+                     {"global_ba", e.global_ba},
+                     {"global_ba_merged", e.global_ba_merged},
+                     {"global_ba_keyframes", e.global_ba_keyframes},
+                     {"global_ba_points", e.global_ba_points},
+                     {"global_ba_merged_at_keyframe", e.global_ba_merged_at_keyframe},
+                     {"global_ba_ms", e.global_ba_ms}});
   }
   j["loops"] = std::move(loops);
   return j;

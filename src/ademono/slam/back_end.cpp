@@ -38,6 +38,11 @@ void BackEnd::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
   local_mapping_.Shutdown();
+  if (loop_closing_) {
+    // A global BA still pending after the last keyframe is merged now (a fixed point too).
+    MutexLock lock(map_.mutex);
+    loop_closing_->FinishGlobalBundleAdjustment();
+  }
 }
 
 namespace {

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
+#include <thread>
 
 #include "ademono/core/timing.h"
 #include "ademono/feature/matching.h"
@@ -227,8 +229,14 @@ std::optional<LoopClosing::Verified> LoopClosing::Verify(KeyFrame& query,
   return v;
 }
 
+LoopClosing::~LoopClosing() {
+  if (global_ba_ && global_ba_->worker.joinable()) global_ba_->worker.join();
+}
+
 bool LoopClosing::Process(KeyFrame& keyframe) {
   if (!options_.enabled || keyframe.bad) return false;
+  if (global_ba_ && ++global_ba_->keyframes_since >= options_.global_ba_handoff_keyframes)
+    EndGlobalBundleAdjustment(true, keyframe.id);
   if (static_cast<int>(map_.NumKeyFrames()) < options_.min_keyframes ||
       (any_loop_ && keyframe.id < last_loop_keyframe_ + options_.recent_keyframes)) {
     groups_.clear();
@@ -290,6 +298,8 @@ bool LoopClosing::Process(KeyFrame& keyframe) {
   event.matches = accepted->matches;
   event.scale = accepted->match_from_query.scale;
   event.sim3 = sim3_;
+  // The pending global BA was gathered before this loop: its poses would undo the correction.
+  if (global_ba_) EndGlobalBundleAdjustment(false, keyframe.id);
   Correct(keyframe, *accepted, event);
   event.milliseconds = MsSince(start);
   spdlog::info("loop closed: keyframe {} (frame {}) with keyframe {} (frame {}): {} matches, "
@@ -300,7 +310,123 @@ bool LoopClosing::Process(KeyFrame& keyframe) {
   groups_.clear();
   any_loop_ = true;
   last_loop_keyframe_ = keyframe.id;
+  if (options_.global_ba) StartGlobalBundleAdjustment(events_.size() - 1);
   return true;
+}
+
+void LoopClosing::FinishGlobalBundleAdjustment() {
+  if (!global_ba_) return;
+  uint64_t last = 0;
+  for (const auto& [id, kf] : map_.KeyFrames()) last = std::max(last, id);
+  EndGlobalBundleAdjustment(true, last);
+}
+
+void LoopClosing::StartGlobalBundleAdjustment(size_t event) {
+  auto job = std::make_unique<GlobalBa>();
+  job->event = event;
+  BundleAdjustmentProblem& problem = job->problem;
+  std::map<const KeyFrame*, size_t> camera_index;
+  for (const auto& [id, kf] : map_.KeyFrames()) {
+    if (kf->bad) continue;
+    // The oldest keyframe fixes the gauge (with network depth the depth residuals fix the scale).
+    if (problem.cameras.empty()) problem.intrinsics = kf->F().intrinsics;
+    camera_index[kf.get()] = problem.cameras.size();
+    problem.cameras.push_back({kf->cam_from_world, problem.cameras.empty()});
+    job->keyframes.push_back(kf);
+  }
+  for (const auto& [id, p] : map_.MapPoints()) {
+    if (p->bad) continue;
+    const size_t point_index = problem.points.size();
+    size_t observed = 0;
+    for (const auto& [kf, idx] : p->observations) {  // keyframe id order
+      const auto it = camera_index.find(kf);
+      if (it == camera_index.end()) continue;
+      problem.observations.push_back({it->second, point_index, kf->F().Observation(idx)});
+      ++observed;
+    }
+    if (observed == 0) continue;
+    problem.points.push_back(p->position);
+    job->points.push_back(p);
+  }
+  LoopEvent& e = events_[event];
+  e.global_ba = true;
+  e.global_ba_keyframes = problem.cameras.size();
+  e.global_ba_points = problem.points.size();
+  if (problem.cameras.size() < 2 || problem.points.empty()) return;
+  BundleAdjustmentOptions ba;
+  ba.first_iterations = options_.global_ba_iterations;
+  ba.second_iterations = options_.global_ba_iterations;
+  GlobalBa* raw = job.get();
+  // Touches only the snapshot in *raw, never the map (single-threaded Ceres: deterministic).
+  job->worker = std::thread([raw, ba] {
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      raw->result = SolveBundleAdjustment(raw->problem, ba);
+    } catch (...) {
+      raw->failure = std::current_exception();  // rethrown on the tracking thread at the merge
+    }
+    raw->ms = MsSince(start);
+  });
+  global_ba_ = std::move(job);
+}
+
+void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
+  std::unique_ptr<GlobalBa> job = std::move(global_ba_);
+  job->worker.join();
+  if (job->failure) std::rethrow_exception(job->failure);
+  LoopEvent& e = events_[job->event];
+  e.global_ba_ms = job->ms;
+  if (!apply) {
+    spdlog::info("global BA after the loop at keyframe {} dropped: a newer loop came first",
+                 e.query_keyframe);
+    return;
+  }
+  const BundleAdjustmentResult& result = *job->result;
+  // Each keyframe's pose before and after, for what was added or moved since the snapshot.
+  std::map<const KeyFrame*, std::pair<Rigid3d, Rigid3d>, KeyFrameIdLess> moved;
+  for (size_t k = 0; k < job->keyframes.size(); ++k) {
+    KeyFrame* kf = job->keyframes[k].get();
+    if (kf->bad) continue;
+    moved[kf] = {kf->cam_from_world, result.cam_from_world[k]};
+  }
+  // Keyframes made since follow their spanning-tree ancestor (ids grow along the tree, so the
+  // ancestor is already moved when its descendant comes).
+  for (const auto& [id, kf] : map_.KeyFrames()) {
+    if (kf->bad || moved.count(kf.get())) continue;
+    const KeyFrame* ancestor = kf->parent;
+    while (ancestor != nullptr && !moved.count(ancestor)) ancestor = ancestor->parent;
+    if (ancestor == nullptr) continue;
+    const auto& [before, after] = moved.at(ancestor);
+    moved[kf.get()] = {kf->cam_from_world, kf->cam_from_world * before.inverse() * after};
+  }
+  std::set<const MapPoint*> solved;
+  for (size_t i = 0; i < job->points.size(); ++i) {
+    MapPoint* p = job->points[i].get();
+    if (p->bad) continue;
+    p->position = result.points[i];
+    solved.insert(p);
+  }
+  // Points made since follow their reference keyframe.
+  for (const auto& [id, p] : map_.MapPoints()) {
+    if (p->bad || solved.count(p.get())) continue;
+    const KeyFrame* ref = p->reference;
+    if ((ref == nullptr || ref->bad) && !p->observations.empty())
+      ref = p->observations.begin()->first;
+    const auto m = ref != nullptr ? moved.find(ref) : moved.end();
+    if (m == moved.end()) continue;
+    p->position = m->second.second.inverse() * (m->second.first * p->position);
+  }
+  for (auto& [kf, poses] : moved) const_cast<KeyFrame*>(kf)->cam_from_world = poses.second;
+  for (const auto& [id, p] : map_.MapPoints()) {
+    if (!p->bad) p->UpdateNormalAndDepth();
+  }
+  e.global_ba_merged = true;
+  e.global_ba_merged_at_keyframe = at_keyframe;
+  spdlog::info("global BA after the loop at keyframe {}: {} keyframes, {} points, {:.0f} ms, "
+               "merged at keyframe {}",
+               e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
+               at_keyframe);
+  map_.NoteLoopCorrection();  // tracking follows its reference keyframe
 }
 
 void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& event) {

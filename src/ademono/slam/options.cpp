@@ -139,7 +139,10 @@ const OptionsTable<LoopOptions>& LoopOptions::Table() {
           .Add("consistency", &L::consistency, Range::AtLeast(1))
           .Add("strong_edge_weight", &L::strong_edge_weight, Range::AtLeast(1))
           .Add("pose_graph_iterations", &L::pose_graph_iterations, Range::AtLeast(1))
-          .Add("transform", &L::transform);
+          .Add("transform", &L::transform)
+          .Add("global_ba", &L::global_ba)
+          .Add("global_ba_iterations", &L::global_ba_iterations, Range::AtLeast(1))
+          .Add("global_ba_handoff_keyframes", &L::global_ba_handoff_keyframes, Range::AtLeast(1));
   return table;
 }
 

@@ -170,6 +170,11 @@ struct LoopOptions {
   // "auto": Sim(3) when depth is a network's prior (its scale drifts), SE(3) with sensor depth;
   // "sim3" | "se3" force one.
   std::string transform = "auto";
+  // Global bundle adjustment after each loop, on its own thread, merged once loop closing has
+  // seen `global_ba_handoff_keyframes` more keyframes (or at the end); Ceres iterations per solve.
+  bool global_ba = false;
+  int global_ba_iterations = 10;
+  int global_ba_handoff_keyframes = 2;
   bool UseSim3(bool depth_is_prior) const {
     return transform == "sim3" || (transform == "auto" && depth_is_prior);
   }
