@@ -67,6 +67,19 @@ run bonn_fastdepth_yolox "$bonn" FastDepth YOLOX-nano "boxes + geometry" --depth
     --detector "$bonn_det"
 run seqa_sensor_yolox "$seqa" sensor YOLOX-nano "boxes + geometry" --detector "$seqa_det"
 
+# The same comparison through `ademono ablate` (docs/ablation.md): the real detector with boxes and
+# geometry (full), the paper's two-stage rule alone (boxes_only), the geometric test with no
+# detector (geometry_only), and no dynamic handling at all (no_dynamic).
+if ! { [ "${REUSE:-0}" = 1 ] && [ -f "$work/bonn_ablate/ablation.md" ]; }; then
+  rm -rf "${work:?}/bonn_ablate"
+  "$bin" ablate --dataset "$bonn" --detector "$bonn_det" \
+    --variants full,boxes_only,geometry_only,no_dynamic --out "$work/bonn_ablate" \
+    > "$work/bonn_ablate.log" 2>&1 || echo "(ablate failed: see $work/bonn_ablate.log)" >&2
+fi
+
 echo "| run | depth | detector | removal | ATE se3 (m) | ATE sim3 (m) x scale | untracked | weak poses (few static + motion model) | keypoints removed by boxes | matches judged moving by geometry |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"
+echo
+echo "ademono ablate --dataset $bonn --detector $bonn_det --variants full,boxes_only,geometry_only,no_dynamic:"
+cat "$work/bonn_ablate/ablation.md" 2>/dev/null || true

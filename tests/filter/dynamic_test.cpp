@@ -188,6 +188,30 @@ TEST(RemoveDynamicPointsTest, BoxVoteOnlyForBoxesWhoseMatchedPointsMoved) {
   EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[10], PointLabel::kKept);
 }
 
+TEST(RemoveDynamicPointsTest, BoxVoteSparesTheBackgroundBehindTheMover) {
+  // The large box's three failed points are at 2 m: the mover. The unmatched point, no verdict
+  // of its own, at 4 m is the background seen around the mover (kept); at 2.2 m it is on the mover.
+  const Scene s;
+  std::vector<float> depths(Scene::kCount, 0.f);
+  depths[Scene::kLargeStage1] = depths[Scene::kLargeStage2] = depths[Scene::kLargeBehind] = 2.f;
+  DynamicInput in = s.Input();
+  in.depths = &depths;
+  const DynamicParams p = Params();
+  depths[Scene::kLargeUnmatched] = 4.f;
+  EXPECT_EQ(RemoveDynamicPoints(in, p).labels[Scene::kLargeUnmatched], PointLabel::kKept);
+  depths[Scene::kLargeUnmatched] = 2.2f;
+  EXPECT_EQ(RemoveDynamicPoints(in, p).labels[Scene::kLargeUnmatched], PointLabel::kDynamicBoxVote);
+  depths[Scene::kLargeUnmatched] = 0.f;  // no depth: nothing says it is behind
+  EXPECT_EQ(RemoveDynamicPoints(in, p).labels[Scene::kLargeUnmatched], PointLabel::kDynamicBoxVote);
+  depths[Scene::kLargeUnmatched] = 4.f;
+  DynamicParams off = p;
+  off.box_vote_depth_ratio = 0.0;  // the vote as before: every point without a verdict
+  EXPECT_EQ(RemoveDynamicPoints(in, off).labels[Scene::kLargeUnmatched],
+            PointLabel::kDynamicBoxVote);
+  depths[Scene::kLargeBehind] = 0.f;  // two failed points with depth: the mover's depth unknown
+  EXPECT_EQ(RemoveDynamicPoints(in, p).labels[Scene::kLargeUnmatched], PointLabel::kDynamicBoxVote);
+}
+
 TEST(RemoveDynamicPointsTest, LargerTIncludesTheOutlierInTheBackgroundMotion) {
   const Scene s;
   DynamicParams p = Params();

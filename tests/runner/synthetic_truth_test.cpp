@@ -74,6 +74,22 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   EXPECT_EQ(geometric.moving_removed, 2);
   EXPECT_EQ(geometric.moving_unboxed_removed, 2);
   EXPECT_EQ(geometric.static_removed, unboxed.static_removed + 1);
+  // What removed them: the box filter's labels first, the geometric test only where none.
+  EXPECT_EQ(geometric.static_removed_box_vote, 1);
+  EXPECT_EQ(geometric.static_removed_small_box, 1);
+  EXPECT_EQ(geometric.static_removed_stage1, 0);
+  EXPECT_EQ(geometric.static_removed_geometric, 1);
+  EXPECT_EQ(geometric.moving_removed_geometric, 1);
+  EXPECT_EQ(geometric.static_at_mover_edge_keypoints, 0);
+  // A corner just outside the mover's outline (x = 51, 2 px from its last pixel) is static but
+  // at the mover's edge; 3 px away it is not.
+  TruthCounts edge;
+  truth.Score(frame, {}, {{51, 50, 7}, {53, 50, 7}}, {PointLabel::kDynamicStage1, PointLabel::kKept},
+              &edge);
+  EXPECT_EQ(edge.static_keypoints, 2);
+  EXPECT_EQ(edge.static_at_mover_edge_keypoints, 1);
+  EXPECT_EQ(edge.static_at_mover_edge_removed, 1);
+  EXPECT_EQ(edge.static_removed_stage1, 1);
 
   frame.name = "missing";
   EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);

@@ -250,29 +250,45 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
   // of its own, but if enough of the judged points of its large box failed stage 1 or 2 the box
   // holds a moving object, and the unjudged points (mostly on the object: its texture and
   // silhouette change frame to frame) go with it. A static object's box keeps them.
+  // A box is larger than its mover: the background seen around a walker inside the grown box is
+  // unjudged too (on the photo-actor office most of the static points removed were these), so a
+  // point clearly behind the mover's depth is spared and left to the tracker's geometric test.
   if (params.box_vote_ratio <= 1.0) {
     std::vector<char> moving_box(result.boxes.size(), 0);
+    std::vector<double> mover_depth(result.boxes.size(), 0.0);  // 0: unknown
     for (size_t b = 0; b < result.boxes.size(); ++b) {
       if (result.boxes[b].small) continue;
       int num_judged = 0, num_dynamic = 0;
+      std::vector<float> failed_depths;
       for (size_t i = 0; i < n; ++i) {
         if (!active(i) || !judged[i] || !InsideBox(result.boxes[b].box, kps[i].pt)) continue;
         ++num_judged;
         if (result.labels[i] == PointLabel::kDynamicStage1 ||
-            result.labels[i] == PointLabel::kDynamicStage2)
+            result.labels[i] == PointLabel::kDynamicStage2) {
           ++num_dynamic;
+          const float z = input.depths != nullptr ? (*input.depths)[i] : 0.f;
+          if (z > 0.f && std::isfinite(z)) failed_depths.push_back(z);
+        }
       }
       moving_box[b] = num_judged >= params.box_vote_min_matches &&
                       num_dynamic >= params.box_vote_ratio * static_cast<double>(num_judged);
+      if (moving_box[b] && failed_depths.size() >= 3) {
+        const auto mid = failed_depths.begin() + static_cast<std::ptrdiff_t>(failed_depths.size() / 2);
+        std::nth_element(failed_depths.begin(), mid, failed_depths.end());
+        mover_depth[b] = *mid;
+      }
     }
     for (size_t i = 0; i < n; ++i) {
       if (!active(i) || !in_large[i] || judged[i] || result.labels[i] != PointLabel::kKept)
         continue;
+      const float z = input.depths != nullptr ? (*input.depths)[i] : 0.f;
       for (size_t b = 0; b < result.boxes.size(); ++b) {
-        if (moving_box[b] && InsideBox(result.boxes[b].box, kps[i].pt)) {
-          result.labels[i] = PointLabel::kDynamicBoxVote;
-          break;
-        }
+        if (!moving_box[b] || !InsideBox(result.boxes[b].box, kps[i].pt)) continue;
+        const bool behind = params.box_vote_depth_ratio > 0.0 && mover_depth[b] > 0.0 && z > 0.f &&
+                            std::isfinite(z) && z > params.box_vote_depth_ratio * mover_depth[b];
+        if (behind) continue;  // background seen inside this box; another box may still claim it
+        result.labels[i] = PointLabel::kDynamicBoxVote;
+        break;
       }
     }
   }

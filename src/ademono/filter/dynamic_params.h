@@ -28,6 +28,10 @@ struct DynamicParams {
   // > 1 disables.
   double box_vote_ratio = 0.15;
   int box_vote_min_matches = 5;
+  // The vote spares a point whose depth is beyond this times the mover's depth (the median depth of
+  // the box's points that failed stage 1 or 2, when at least three have one): the background seen
+  // around the mover inside its box. 0 votes every point without a verdict away, as before.
+  double box_vote_depth_ratio = 1.3;
   std::vector<int> dynamic_class_ids = DefaultDynamicClassIds();
   // Frame-to-frame matching for stage 1 (ORB-SLAM's usual values; not in the YAML).
   double match_ratio = 0.8;

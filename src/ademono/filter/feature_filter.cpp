@@ -50,6 +50,7 @@ const OptionsTable<DynamicParams>& DynamicParams::Table() {
           .Add("stage1_motion_compensation", &P::stage1_motion_compensation)
           .Add("box_vote_ratio", &P::box_vote_ratio, Range::AtLeast(0))  // > 1 disables the vote
           .Add("box_vote_min_matches", &P::box_vote_min_matches, Range::AtLeast(1))
+          .Add("box_vote_depth_ratio", &P::box_vote_depth_ratio, Range::AtLeast(0))  // 0: off
           .Add("dynamic_class_ids", &P::dynamic_class_ids)
           .Add("motion_min_inliers", &P::motion_min_inliers, Range::AtLeast(4))
           .Add("motion_inlier_px", &P::motion_inlier_px, Range::Above(0))

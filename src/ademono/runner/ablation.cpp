@@ -112,9 +112,10 @@ std::string AblationMarkdown(const std::vector<VariantResult>& results) {
   const bool truth = !results.empty() && results.front().truth.has_value();
   os << "| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked | keyframes | "
         "removed enh | removed dyn (small/st1/st2/vote) | removed distant (of >Z_th) |";
-  if (truth) os << " moving removed | static person removed |";
+  if (truth)
+    os << " moving removed | unboxed moving removed | static removed | static person removed |";
   os << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|";
-  if (truth) os << "---|---|";
+  if (truth) os << "---|---|---|---|";
   os << "\n";
   auto onoff = [](bool b) { return b ? "on" : "off"; };
   for (const VariantResult& r : results) {
@@ -136,6 +137,8 @@ std::string AblationMarkdown(const std::vector<VariantResult>& results) {
       };
       const TruthCounts t = r.truth.value_or(TruthCounts{});
       os << " " << pct(t.moving_removed, t.moving_keypoints) << " | "
+         << pct(t.moving_unboxed_removed, t.moving_unboxed_keypoints) << " | "
+         << pct(t.static_removed, t.static_keypoints) << " | "
          << pct(t.static_person_removed, t.static_person_keypoints) << " |";
     }
     os << "\n";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 
 #include "ademono/core/error.h"
@@ -31,7 +32,16 @@ nlohmann::json TruthCounts::ToJson() const {
           {"static_person_removed_ratio", ratio(static_person_removed, static_person_keypoints)},
           {"static_in_box_keypoints", static_in_box_keypoints},
           {"static_in_box_removed", static_in_box_removed},
-          {"static_in_box_removed_ratio", ratio(static_in_box_removed, static_in_box_keypoints)}};
+          {"static_in_box_removed_ratio", ratio(static_in_box_removed, static_in_box_keypoints)},
+          {"static_removed_by",
+           {{"small_box", static_removed_small_box},
+            {"stage1", static_removed_stage1},
+            {"stage2", static_removed_stage2},
+            {"box_vote", static_removed_box_vote},
+            {"geometric", static_removed_geometric}}},
+          {"static_at_mover_edge_keypoints", static_at_mover_edge_keypoints},
+          {"static_at_mover_edge_removed", static_at_mover_edge_removed},
+          {"moving_removed_geometric", moving_removed_geometric}};
 }
 
 SyntheticTruth::SyntheticTruth(const fs::path& sequence_dir) : masks_dir_(sequence_dir / "masks") {
@@ -71,6 +81,8 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       static_box = box;
     }
   }
+  cv::Mat near_mover;  // moving pixels grown by 2 px
+  cv::dilate(mask > 127, near_mover, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
   for (size_t i = 0; i < keypoints.size() && i < labels.size(); ++i) {
     const cv::Point p = Pixel(keypoints[i], mask.size());
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
@@ -83,9 +95,11 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
              d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
     });
+    const bool geometric_only = dynamic && !IsDynamic(labels[i]);
     if (mask.at<uint8_t>(p) > 127) {
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;
+      if (geometric_only) ++counts->moving_removed_geometric;
       if (labels[i] == PointLabel::kKept) ++counts->moving_kept;
       if (!in_box) {
         ++counts->moving_unboxed_keypoints;
@@ -94,6 +108,18 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
     } else {
       ++counts->static_keypoints;
       if (dynamic) ++counts->static_removed;
+      if (geometric_only) ++counts->static_removed_geometric;
+      if (near_mover.at<uint8_t>(p) != 0) {
+        ++counts->static_at_mover_edge_keypoints;
+        if (dynamic) ++counts->static_at_mover_edge_removed;
+      }
+      switch (labels[i]) {
+        case PointLabel::kDynamicSmallBox: ++counts->static_removed_small_box; break;
+        case PointLabel::kDynamicStage1: ++counts->static_removed_stage1; break;
+        case PointLabel::kDynamicStage2: ++counts->static_removed_stage2; break;
+        case PointLabel::kDynamicBoxVote: ++counts->static_removed_box_vote; break;
+        default: break;
+      }
       if (static_box && static_box->contains(p)) {
         ++counts->static_person_keypoints;
         if (dynamic) ++counts->static_person_removed;

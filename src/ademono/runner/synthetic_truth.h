@@ -35,6 +35,18 @@ struct TruthCounts {
   // static objects such as parked cars, and background seen inside boxes.
   long long static_in_box_keypoints = 0;
   long long static_in_box_removed = 0;  // ... labelled dynamic
+  // What removed the static keypoints (each counted once, the filter's label first): the box
+  // filter's small box / stage 1 / stage 2 / box vote, and the geometric test alone.
+  long long static_removed_small_box = 0;
+  long long static_removed_stage1 = 0;
+  long long static_removed_stage2 = 0;
+  long long static_removed_box_vote = 0;
+  long long static_removed_geometric = 0;
+  // Static keypoints within 2 px of a moving object's pixels: corners on a mover's silhouette,
+  // whose ORB patch is half mover (which side of the outline the rounded pixel falls is chance).
+  long long static_at_mover_edge_keypoints = 0;
+  long long static_at_mover_edge_removed = 0;
+  long long moving_removed_geometric = 0;  // moving keypoints only the geometric test removed
   nlohmann::json ToJson() const;
 };
 
