@@ -16,7 +16,7 @@ function(ademono_add_test name)
     add_dependencies(${name} ademono_cli)
   endif()
   set(_env "")
-  if(ADEMONO_SANITIZE)
+  if(ADEMONO_SANITIZE OR ADEMONO_FUZZ)
     # ONNX Runtime leaks 14 bytes of its own at start-up; nothing of ademono's is suppressed.
     set(_env "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tools/lsan_onnxruntime.supp")
   endif()
