@@ -177,6 +177,10 @@ TEST_F(MapIoTest, BadMapsFailWithOneLineNamingTheFile) {
   MapFileData data = LoadMapFile(MapPath());
   data.points.front().observations.front().first = 999999;
   expect_error(SerializeMapFile(data), "unknown keyframe");
+  // Found by fuzz_map_file in CI: a keypoint at 1.6e28 px overflowed the grid's int cast.
+  data = LoadMapFile(MapPath());
+  data.keyframes.front().keypoints.front().x = 1.58577e28f;
+  expect_error(SerializeMapFile(data), "keypoint outside the image");
 }
 
 TEST_F(MapIoTest, CameraThatDiffersFromTheSequenceIsRejected) {

@@ -86,10 +86,12 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
   const float cell_h = (f->max_y - f->min_y) / FrameFeatures::kGridRows;
   for (size_t i = 0; i < n; ++i) {
     const cv::Point2f& p = f->keypoints_un[i].pt;
-    const int cx = static_cast<int>(std::floor((p.x - f->min_x) / cell_w));
-    const int cy = static_cast<int>(std::floor((p.y - f->min_y) / cell_h));
-    if (cx < 0 || cx >= FrameFeatures::kGridCols || cy < 0 || cy >= FrameFeatures::kGridRows)
+    // Compared as floats before the cast: a far outlier would overflow int (undefined).
+    const float gx = std::floor((p.x - f->min_x) / cell_w);
+    const float gy = std::floor((p.y - f->min_y) / cell_h);
+    if (!(gx >= 0.f && gx < FrameFeatures::kGridCols && gy >= 0.f && gy < FrameFeatures::kGridRows))
       continue;
+    const int cx = static_cast<int>(gx), cy = static_cast<int>(gy);
     f->grid[cy * FrameFeatures::kGridCols + cx].push_back(i);
   }
   return f;

@@ -170,6 +170,10 @@ void Validate(const MapFileData& d, const std::filesystem::path& path) {
       if (!Finite(kp.x) || !Finite(kp.y) || !Finite(kp.size) || !Finite(kp.response) ||
           !(kp.angle >= -1.f && kp.angle <= 360.f) || kp.octave < 0)
         fail(where + "bad keypoint");
+      // Keypoints are extracted on the image; one pixel of slack for sub-pixel positions.
+      if (!(kp.x >= -1.0 && kp.x <= d.camera.width + 1.0 && kp.y >= -1.0 &&
+            kp.y <= d.camera.height + 1.0))
+        fail(where + "keypoint outside the image");
     }
     for (float z : k.depth)
       if (!std::isfinite(z)) fail(where + "depth is not finite");
