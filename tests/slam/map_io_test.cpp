@@ -181,6 +181,10 @@ TEST_F(MapIoTest, BadMapsFailWithOneLineNamingTheFile) {
   data = LoadMapFile(MapPath());
   data.keyframes.front().keypoints.front().x = 1.58577e28f;
   expect_error(SerializeMapFile(data), "keypoint outside the image");
+  // Also found by fuzz_map_file: a flag byte of 3 loaded into a bool (undefined behaviour).
+  data = LoadMapFile(MapPath());
+  data.keyframes.front().weight_by_error_model = 3;
+  expect_error(SerializeMapFile(data), "bad weight_by_error_model flag");
 }
 
 TEST_F(MapIoTest, CameraThatDiffersFromTheSequenceIsRejected) {

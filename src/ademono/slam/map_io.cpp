@@ -181,6 +181,7 @@ void Validate(const MapFileData& d, const std::filesystem::path& path) {
         !(k.depth_scale > 0) || !Finite(k.depth_error_relative) ||
         !Finite(k.depth_error_per_metre))
       fail(where + "bad depth parameters");
+    if (k.weight_by_error_model > 1) fail(where + "bad weight_by_error_model flag");
     num_keypoints[k.id] = n;
   }
   if (d.keyframes.empty()) fail("the map has no keyframe");
@@ -244,7 +245,7 @@ MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptio
     r.close_depth = f.close_depth;
     r.depth_error_relative = f.depth_error.relative;
     r.depth_error_per_metre = f.depth_error.per_metre;
-    r.weight_by_error_model = f.weight_by_error_model;
+    r.weight_by_error_model = f.weight_by_error_model ? 1 : 0;
     r.depth_scale = f.depth_scale;
     r.parent = kf->parent != nullptr && !kf->parent->bad ? static_cast<int64_t>(kf->parent->id) : -1;
     for (const auto& [other, weight] : kf->connections)
@@ -440,7 +441,7 @@ void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyrami
     auto built = MakeFrameFeatures(data.camera, pyramid, data.camera.fx > 0 ? r.bf / data.camera.fx : 0,
                                    r.close_depth, std::move(keypoints), descriptors, r.depth,
                                    {r.depth_error_relative, r.depth_error_per_metre},
-                                   r.weight_by_error_model);
+                                   r.weight_by_error_model != 0);
     // Exactly the saved values (bf / fx * fx may differ in the last bit).
     auto features = std::make_shared<FrameFeatures>(*built);
     features->intrinsics.bf = r.bf;

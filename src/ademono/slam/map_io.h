@@ -41,7 +41,9 @@ struct MapKeyFrameRecord {
   double bf = 0;                     // virtual stereo baseline x fx
   float close_depth = 0;
   double depth_error_relative = 0, depth_error_per_metre = 0;
-  bool weight_by_error_model = true;
+  // A byte, not a bool: any other value than 0 or 1 is rejected on load (a bool read from
+  // arbitrary bytes would be undefined). Same one-byte layout as before.
+  uint8_t weight_by_error_model = 1;
   float depth_scale = 1;
   int64_t parent = -1;  // spanning tree parent id, -1 for the root
   std::vector<std::pair<uint64_t, int32_t>> connections;  // covisibility: (keyframe id, weight)
