@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     KeyFrameDatabase database;
     Map map;
     map.SetKeyFrameDatabase(&database);
-    std::lock_guard<std::mutex> lock(map.mutex);
+    MutexLock lock(map.mutex);
     RestoreMap(map_data, std::make_shared<ScalePyramid>(ScalePyramid::Make(8, 1.2f)), map, "fuzz.map");
     fuzz::g_sink = static_cast<double>(map.NumKeyFrames() + map.NumMapPoints());
   });

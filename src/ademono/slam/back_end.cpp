@@ -41,6 +41,7 @@ void BackEnd::Shutdown() {
   if (loop_closing_) {
     // A global BA still pending after the last keyframe is merged now (a fixed point too).
     MutexLock lock(map_.mutex);
+    loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
     loop_closing_->FinishGlobalBundleAdjustment();
   }
 }
