@@ -73,6 +73,27 @@ TEST(BundleAdjustmentTest, RefinesPosesAndPointsAndKeepsFixedCamera) {
   EXPECT_LT(outliers, 10);
 }
 
+TEST(BundleAdjustmentTest, FixedPointsStayAndAnchorTheRest) {
+  // A loaded map's points in localisation only: held exactly where they are.
+  std::mt19937 rng(7);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  problem.point_fixed.assign(problem.points.size(), 0);
+  for (size_t p = 0; p < 50; ++p) {
+    problem.points[p] = points[p];
+    problem.point_fixed[p] = 1;
+  }
+  const BundleAdjustmentResult result = SolveBundleAdjustment(problem);
+  for (size_t p = 0; p < 50; ++p) EXPECT_TRUE(result.points[p] == problem.points[p]) << p;
+  int moved = 0;
+  for (size_t p = 50; p < points.size(); ++p) moved += result.points[p] != problem.points[p];
+  EXPECT_EQ(moved, static_cast<int>(points.size()) - 50);
+  for (int c = 1; c < 3; ++c) {
+    EXPECT_LT((result.cam_from_world[c].translation() - poses[c].translation()).norm(), 0.005) << c;
+  }
+}
+
 TEST(BundleAdjustmentTest, MarksCorruptedObservationsAsOutliers) {
   std::mt19937 rng(8);
   std::vector<Rigid3d> poses;

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <fstream>
 #include <sstream>
 
@@ -116,6 +118,76 @@ TEST_F(MapIoTest, LocalizeOnlyRelocalisesEveryFrameAndNeverChangesTheMap) {
   };
   const Trajectory a = run();
   ASSERT_EQ(a.size(), 30u);
+  double worst = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    const Rigid3d gt = GroundTruthInFirstSession(*full, 60 + k);
+    worst = std::max(worst, (gt.translation() - a[k].world_from_cam.translation()).norm());
+  }
+  EXPECT_LT(worst, 0.05);  // in the first session's frame, no alignment
+  const Trajectory b = run();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i)
+    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+  EXPECT_TRUE(ReadBytes(MapPath()) == before);
+}
+
+TEST_F(MapIoTest, TemporaryMapLocalisationNeverChangesTheLoadedMap) {
+  // tracking.temporary_map: keyframes and points are made beside the loaded map (local BA with
+  // it held fixed) and never saved; the loaded keyframes and points stay exactly as read.
+  const std::string before = ReadBytes(MapPath());
+  const MapFileData loaded = LoadMapFile(MapPath());
+  const auto sequence = Slice(60, 120);
+  const auto full = Slice(0, 120);
+  SystemOptions options = TestOptions();
+  options.tracking.temporary_map = true;
+  auto run = [&]() -> Trajectory {
+    System system(sequence->GetCamera(), options);
+    system.LoadMap(MapPath(), true);
+    std::vector<TrackResult> results;
+    Track(system, *sequence, &results);
+    EXPECT_TRUE(results.front().relocalised);
+    int tracked = 0, new_keyframes = 0;
+    for (const TrackResult& r : results) {
+      tracked += r.tracked;
+      new_keyframes += r.new_keyframe ? 1 : 0;
+    }
+    EXPECT_EQ(tracked, 60);
+    EXPECT_GT(new_keyframes, 0);  // the temporary map is used
+    const MapFileData now = system.MapRecords();
+    EXPECT_GT(now.keyframes.size(), loaded.keyframes.size());
+    std::map<uint64_t, const MapKeyFrameRecord*> keyframes;
+    for (const auto& k : now.keyframes) keyframes[k.id] = &k;
+    for (const auto& k : loaded.keyframes) {
+      if (!keyframes.count(k.id)) {
+        ADD_FAILURE() << "loaded keyframe " << k.id << " culled";
+        continue;
+      }
+      EXPECT_TRUE(keyframes[k.id]->cam_from_world == k.cam_from_world) << k.id;
+    }
+    std::map<uint64_t, const MapPointRecord*> points;
+    for (const auto& p : now.points) points[p.id] = &p;
+    for (const auto& p : loaded.points) {
+      if (!points.count(p.id)) {
+        ADD_FAILURE() << "loaded point " << p.id << " erased";
+        continue;
+      }
+      const MapPointRecord& q = *points[p.id];
+      EXPECT_TRUE(q.position == p.position && q.normal == p.normal &&
+                  q.descriptor == p.descriptor && q.visible == p.visible && q.found == p.found)
+          << p.id;
+      for (const auto& o : p.observations) {
+        EXPECT_TRUE(std::find(q.observations.begin(), q.observations.end(), o) !=
+                    q.observations.end())
+            << p.id;
+      }
+    }
+    const fs::path after = *dir_ / "after_temporary.map";
+    system.SaveMap(after);
+    EXPECT_TRUE(ReadBytes(after) == before) << "a temporary keyframe or point was saved";
+    return system.FrameTrajectory();
+  };
+  const Trajectory a = run();
+  ASSERT_EQ(a.size(), 60u);
   double worst = 0;
   for (size_t k = 0; k < a.size(); ++k) {
     const Rigid3d gt = GroundTruthInFirstSession(*full, 60 + k);

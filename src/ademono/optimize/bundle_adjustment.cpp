@@ -73,7 +73,10 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
     ordering->AddElementToGroup(&cameras[6 * c], 1);
   }
   for (size_t p = 0; p < problem.points.size(); ++p) {
-    if (point_used[p]) ordering->AddElementToGroup(&points[3 * p], 0);
+    if (!point_used[p]) continue;
+    if (p < problem.point_fixed.size() && problem.point_fixed[p])
+      ceres_problem.SetParameterBlockConstant(&points[3 * p]);
+    ordering->AddElementToGroup(&points[3 * p], 0);
   }
 
   ceres::Solver::Options options;

@@ -50,6 +50,8 @@ struct BundleAdjustmentProblem {
   PinholeIntrinsics intrinsics;
   std::vector<BaCamera> cameras;
   std::vector<Eigen::Vector3d> points;  // world
+  // Per point: held fixed (a loaded map's point in localisation only); empty: every point free.
+  std::vector<uint8_t> point_fixed;
   std::vector<BaObservation> observations;
 };
 

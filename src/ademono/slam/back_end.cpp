@@ -77,12 +77,24 @@ void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
   MutexLock lock(map_.mutex);
   if (map_.NumKeyFrames() != 0) throw std::logic_error("BackEnd::LoadMap: the map is not empty");
   RestoreMap(data, pyramid, map_, path);
+  if (localize_only) {
+    // Mapping may add temporary keyframes and points beside the loaded ones (tracking's
+    // temporary_map) but never changes these; a loop correction would move them, so none.
+    for (const auto& [id, kf] : map_.KeyFrames()) kf->frozen = true;
+    for (const auto& [id, p] : map_.MapPoints()) p->frozen = true;
+    local_mapping_.SetLoopClosing(nullptr);
+    loaded_map_ = data;
+  }
   tracking_.AssertMapHeld();  // tracking's name for the same lock
   tracking_.StartInLoadedMap(localize_only);
 }
 
 void BackEnd::SaveMap(const std::filesystem::path& path) {
   Shutdown();
+  if (loaded_map_) {
+    SaveMapFile(path, *loaded_map_);
+    return;
+  }
   MapFileData data;
   {
     MutexLock lock(map_.mutex);
@@ -220,6 +232,11 @@ std::vector<ColoredPoint> BackEnd::MapPointCloud() const {
         {p->position, it == point_colors_.end() ? cv::Vec3b(255, 255, 255) : it->second});
   }
   return cloud;
+}
+
+MapFileData BackEnd::MapRecords() const {
+  MutexLock lock(map_.mutex);
+  return MapToRecords(map_, camera_, options_);
 }
 
 size_t BackEnd::NumKeyFrames() const {

@@ -18,6 +18,7 @@
 #include "ademono/slam/local_mapping.h"
 #include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
+#include "ademono/slam/map_io.h"
 #include "ademono/slam/options.h"
 #include "ademono/slam/tracking.h"
 
@@ -57,8 +58,10 @@ class BackEnd {
 
   // Map reuse (docs/maps.md). LoadMap: before the first frame; restores a saved map (InputError
   // naming the file for a bad map or a camera that differs from this system's), then the first
-  // frames relocalise in it. With `localize_only` the map is never changed. SaveMap finishes
-  // local mapping (Shutdown) and writes the map atomically.
+  // frames relocalise in it. With `localize_only` the map is never changed (its keyframes and
+  // points are frozen; tracking.temporary_map may add temporary ones beside them, which are never
+  // saved) and no loop is closed. SaveMap finishes local mapping (Shutdown) and writes the map
+  // atomically (after localisation only: the loaded map as it was read).
   void LoadMap(const std::filesystem::path& path, bool localize_only,
                const std::shared_ptr<const ScalePyramid>& pyramid);
   void SaveMap(const std::filesystem::path& path);
@@ -71,6 +74,7 @@ class BackEnd {
   Trajectory KeyFrameTrajectory() const;
   std::vector<std::pair<size_t, double>> DepthScales() const;
   std::vector<ColoredPoint> MapPointCloud() const;
+  MapFileData MapRecords() const;
   size_t NumKeyFrames() const;
   size_t NumMapPoints() const;
   int NumLost() const;
@@ -96,6 +100,8 @@ class BackEnd {
   // Colour of each map point's first observation (for map.ply), keyed by point id.
   std::map<uint64_t, cv::Vec3b> point_colors_;
   size_t frames_ = 0;  // Track calls so far: the hand-off schedule's clock
+  // Localisation only: the map as loaded, what SaveMap writes (temporary keyframes never are).
+  std::optional<MapFileData> loaded_map_;
   bool shut_down_ = false;
 };
 

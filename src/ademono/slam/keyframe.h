@@ -32,6 +32,9 @@ class KeyFrame {
   std::set<KeyFrame*, KeyFrameIdLess> children;
   Rigid3d cam_from_parent = Rigid3d::Identity();  // set when the keyframe is culled
   bool bad = false;
+  // Part of a map loaded for localisation only: its pose and its map points never change, it is
+  // never culled (temporary keyframes may connect to it in the covisibility graph).
+  bool frozen = false;
 
   // Scratch of the tracker and local mapping.
   uint64_t local_map_frame = UINT64_MAX;

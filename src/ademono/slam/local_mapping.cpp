@@ -218,7 +218,8 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
   const Matcher matcher(0.6f, false);
   int created = 0;
   for (KeyFrame* k2 : keyframe.BestCovisibles(options_.triangulation_neighbours)) {
-    if (k2->bad) continue;
+    // A loaded map's keyframe (localisation only) takes no new point.
+    if (k2->bad || k2->frozen) continue;
     // Too short a baseline for the scene's depth: triangulation would be noise.
     std::vector<double> depths;
     for (const auto& p : k2->map_points) {
@@ -300,8 +301,10 @@ void LocalMapping::FuseNeighbours(KeyFrame& keyframe) {
     }
   }
   const Matcher matcher(0.6f, true);
-  // This keyframe's points into the neighbours.
+  // This keyframe's points into the neighbours (a loaded map's keyframes in localisation only
+  // take none: they never change; their points still come into this keyframe below).
   for (KeyFrame* kf : targets) {
+    if (kf->frozen) continue;
     std::vector<std::shared_ptr<MapPoint>> points;
     for (const auto& p : keyframe.map_points) {
       if (p && !p->bad) points.push_back(p);
@@ -382,7 +385,8 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     auto add_camera = [&](KeyFrame* kf, bool is_fixed) {
       map_.mutex.AssertHeld();  // the analysis does not carry the lock into a lambda
       camera_index[kf] = problem.cameras.size();
-      problem.cameras.push_back({kf->cam_from_world, is_fixed || kf->id == 0});
+      // A loaded map's keyframe (localisation only) is an anchor, never moved.
+      problem.cameras.push_back({kf->cam_from_world, is_fixed || kf->id == 0 || kf->frozen});
       cameras.push_back(map_.GetKeyFrame(kf->id));
     };
     for (KeyFrame* kf : local) add_camera(kf, false);
@@ -396,6 +400,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     for (MapPoint* p : local_points) {
       const size_t point_index = problem.points.size();
       problem.points.push_back(p->position);
+      problem.point_fixed.push_back(p->frozen ? 1 : 0);
       points.push_back(map_.GetMapPoint(p->id));
       for (const auto& [kf, idx] : p->observations) {
         auto it = camera_index.find(kf);
@@ -422,7 +427,8 @@ void LocalMapping::ApplyBundleAdjustment(const Pending& pending) {
     if (!result.outlier[i]) continue;
     auto [kf, idx] = observation_refs[i];
     const std::shared_ptr<MapPoint>& point = points[problem.observations[i].point];
-    if (!point || point->bad || kf->bad) continue;
+    // A loaded map's own observations stay (localisation only: it never changes).
+    if (!point || point->bad || kf->bad || kf->frozen) continue;
     if (kf->map_points[idx] == point) kf->map_points[idx].reset();
     point->EraseObservation(kf);
     if (point->observations.empty()) map_.ErasePoint(point.get());
@@ -432,7 +438,7 @@ void LocalMapping::ApplyBundleAdjustment(const Pending& pending) {
       cameras[c]->cam_from_world = result.cam_from_world[c];
   }
   for (size_t p = 0; p < points.size(); ++p) {
-    if (!points[p] || points[p]->bad) continue;
+    if (!points[p] || points[p]->bad || points[p]->frozen) continue;
     points[p]->position = result.points[p];
     points[p]->UpdateNormalAndDepth();
   }
@@ -441,7 +447,7 @@ void LocalMapping::ApplyBundleAdjustment(const Pending& pending) {
 void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
   if (keyframe.bad) return;
   for (KeyFrame* kf : std::vector<KeyFrame*>(keyframe.ordered_connections)) {
-    if (kf->id == 0 || kf->bad) continue;
+    if (kf->id == 0 || kf->bad || kf->frozen) continue;
     int num_points = 0, num_redundant = 0;
     for (size_t i = 0; i < kf->map_points.size(); ++i) {
       const auto& p = kf->map_points[i];

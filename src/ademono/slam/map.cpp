@@ -60,8 +60,10 @@ void Map::ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new
       kf->map_points[idx].reset();
     }
   }
-  new_point->found += old_point->found;
-  new_point->visible += old_point->visible;
+  if (!new_point->frozen) {  // a loaded map's point keeps its statistics (localisation only)
+    new_point->found += old_point->found;
+    new_point->visible += old_point->visible;
+  }
   new_point->ComputeDistinctiveDescriptor();
   points_.erase(old_point->id);
 }

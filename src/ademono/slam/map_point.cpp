@@ -29,6 +29,7 @@ void MapPoint::EraseObservation(KeyFrame* keyframe) {
 }
 
 void MapPoint::ComputeDistinctiveDescriptor() {
+  if (frozen) return;  // a loaded map's point keeps its descriptor (localisation only)
   // Raw row pointers and one flat distance table: this runs for every point a keyframe touches,
   // and cv::Mat row headers and per-row vectors dominated its cost.
   std::vector<const uchar*> rows;
@@ -61,6 +62,7 @@ void MapPoint::ComputeDistinctiveDescriptor() {
 }
 
 void MapPoint::UpdateNormalAndDepth() {
+  if (frozen) return;  // as ComputeDistinctiveDescriptor
   if (observations.empty() || reference == nullptr) return;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int n = 0;

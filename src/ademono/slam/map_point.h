@@ -37,6 +37,9 @@ class MapPoint {
   // P(static) of the geometric test (slam/static_probability.h); 1 when the test is off.
   double static_probability = 1.0;
   bool bad = false;
+  // Part of a map loaded for localisation only: position, descriptor, normal, statistics and its
+  // observations by loaded keyframes never change (temporary keyframes may observe it).
+  bool frozen = false;
   std::shared_ptr<MapPoint> replaced_by;
 
   // Per-frame scratch of the tracker (which frame last used the point, to avoid duplicates).

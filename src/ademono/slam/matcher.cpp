@@ -269,7 +269,11 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
     if (best_dist > kOrbDistanceLow) continue;
     const std::shared_ptr<MapPoint> existing = keyframe.map_points[best_idx];
     if (existing && !existing->bad) {
-      if (existing->NumObservations() > point->NumObservations()) {
+      // Localisation only: a loaded map's point always survives a fusion, and two of them are
+      // never merged (the loaded map does not change).
+      if (existing->frozen && point->frozen) continue;
+      if (existing->frozen || (!point->frozen &&
+                               existing->NumObservations() > point->NumObservations())) {
         map.ReplacePoint(point.get(), existing);
       } else {
         map.ReplacePoint(existing.get(), point);

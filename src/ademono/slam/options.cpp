@@ -75,7 +75,8 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .AddFlat(&T::static_params, StaticTestParams::Table())
           .Add("weak_pose_max_frames", &T::weak_pose_max_frames, Range::AtLeast(0))
           .Add("weak_pose_min_inliers", &T::weak_pose_min_inliers, Range::AtLeast(3))
-          .Add("weak_pose_sets_velocity", &T::weak_pose_sets_velocity);
+          .Add("weak_pose_sets_velocity", &T::weak_pose_sets_velocity)
+          .Add("temporary_map", &T::temporary_map);
   return table;
 }
 

@@ -110,6 +110,13 @@ struct TrackingOptions {
   // ten-odd points inherits their depth errors, and a jump it teaches is repeated by the next
   // weak frames (bonn-crowd-a, FastDepth: 0.4-0.9 m excursions within 10 frames).
   bool weak_pose_sets_velocity = true;
+  // Localisation only (--load-map --localize-only), where the camera leaves the loaded map:
+  // true keeps a temporary local map in memory (keyframes and points made there, local BA with
+  // the loaded keyframes and points held fixed; never saved, no loop closed), as ORB-SLAM3's
+  // Atlas starts a new map; false tracks frame-to-frame odometry on the previous frame's depth
+  // (ORB-SLAM2's localisation mode). On in the network-depth configs, off with sensor depth
+  // (measured, docs/maps.md).
+  bool temporary_map = false;
   void Check() const;
   static TrackingOptions FromYaml(const YAML::Node& node);
   YAML::Node ToYaml() const;

@@ -93,6 +93,8 @@ class System {
   std::vector<std::pair<size_t, double>> DepthScales() const;
   using ColoredPoint = ademono::ColoredPoint;
   std::vector<ColoredPoint> MapPointCloud() const;
+  // The live map as the records a map file holds (temporary keyframes included; tests).
+  MapFileData MapRecords() const { return back_end_.MapRecords(); }
   size_t NumKeyFrames() const;
   size_t NumMapPoints() const;
   int NumLost() const;

@@ -63,6 +63,7 @@ Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOpti
 void Tracking::StartInLoadedMap(bool localize_only) {
   map_loaded_ = true;
   localize_only_ = localize_only;
+  odometry_localisation_ = localize_only && !options_.tracking.temporary_map;
   state_ = TrackingState::kLost;
   // Frame ids continue after the loaded map's (recent-point and keyframe-spacing rules compare
   // them).
@@ -127,8 +128,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     bool by_motion = false;
     // Localisation only: the untouched frame, for the odometry fallback below.
     std::optional<Frame> pristine;
-    if (localize_only_ && state_ == TrackingState::kOk && velocity_) pristine = frame;
-    if (state_ == TrackingState::kOk && localize_only_ && visual_odometry_) {
+    if (odometry_localisation_ && state_ == TrackingState::kOk && velocity_) pristine = frame;
+    if (state_ == TrackingState::kOk && odometry_localisation_ && visual_odometry_) {
       // Off the map: odometry on the last frame's temporary points, unless relocalisation
       // (tried on a copy) finds the map again.
       Frame relocalised = frame;
@@ -150,7 +151,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       out.relocalised = ok;
     }
     frame.reference_keyframe = reference_keyframe_;
-    if (localize_only_) {
+    if (odometry_localisation_) {
       // Off the map (the motion model found fewer than 10 map points) the odometry pose stands:
       // searching the local map there and mixing the few map points found into the pose was
       // measured worse (seq-a 300-599, FastDepth: ATE 0.136 m instead of 0.051 m; sensor depth
@@ -218,7 +219,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       lost_streak_ = 0;
       weak_streak_ = weak ? weak_streak_ + 1 : 0;
       if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
-      if (!localize_only_ && !weak && NeedNewKeyFrame(frame)) {
+      // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
+      // ones fixed; they are never saved).
+      if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame);
       }
@@ -226,7 +229,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
         if (frame.map_points[i] && frame.outlier[i]) frame.map_points[i].reset();
       }
-      if (localize_only_) AddVisualOdometryPoints(frame);
+      if (odometry_localisation_) AddVisualOdometryPoints(frame);
     } else {
       state_ = TrackingState::kLost;
       velocity_.reset();
@@ -234,7 +237,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).
-      if (!localize_only_ && lost_streak_ > options_.tracking.reinit_after_lost_frames &&
+      if (!odometry_localisation_ && lost_streak_ > options_.tracking.reinit_after_lost_frames &&
           last_good_pose_ &&
           CountDepthPoints(frame) >= options_.tracking.min_init_points) {
         frame.map_points.assign(frame.F().Size(), nullptr);
@@ -442,7 +445,7 @@ bool Tracking::TrackWithMotionModel(Frame& frame) {
   if (matches < options_.tracking.min_motion_matches) return false;
   OptimizeFramePose(frame);
   const int in_map = DiscardOutliers(frame);
-  if (localize_only_) {
+  if (odometry_localisation_) {
     // ORB-SLAM2's localisation mode: few map points means odometry on the temporary ones.
     int total = 0;
     for (const auto& p : frame.map_points) total += p ? 1 : 0;
@@ -475,7 +478,7 @@ void Tracking::UpdateLocalMap(Frame& frame) {
   local_keyframes_.clear();
   // Localisation only, off the map (odometry points alone): the reference keyframe's
   // neighbourhood is the local map, where the map is most likely to come back into view.
-  if (counter.empty() && localize_only_ && reference_keyframe_ != nullptr &&
+  if (counter.empty() && odometry_localisation_ && reference_keyframe_ != nullptr &&
       !reference_keyframe_->bad) {
     counter[reference_keyframe_] = 1;
   }
@@ -528,7 +531,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
       p.reset();
       continue;
     }
-    if (!localize_only_) ++p->visible;
+    if (!p->frozen) ++p->visible;  // a loaded map's statistics never change
     p->last_frame_seen = frame.id;
   }
   std::vector<std::shared_ptr<MapPoint>> candidates;
@@ -538,7 +541,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     if (p->last_frame_seen == frame.id || p->bad) continue;
     ProjectionPrediction prediction;
     if (!frame.InFrustum(*p, 0.5f, &prediction)) continue;
-    if (!localize_only_) ++p->visible;
+    if (!p->frozen) ++p->visible;  // a loaded map's statistics never change
     candidates.push_back(p);
     predictions.push_back(prediction);
   }
@@ -549,13 +552,13 @@ bool Tracking::TrackLocalMap(Frame& frame) {
   const Matcher matcher(0.8f, false);
   matcher.SearchByProjection(frame, candidates, predictions, radius);
 
-  // Localisation only: with enough map points in view the pose rests on them alone, and the
-  // odometry points are dropped (remade from this frame's depth at the map's pose): odometry
-  // points carry the drift of the frames that made them, and outnumbering the map they would
-  // keep it (measured on seq-a frames 300-599: 0.05 m instead of 0.015 m after the map is found
-  // again).
+  // Localisation only by odometry: with enough map points in view the pose rests on them alone,
+  // and the odometry points are dropped (remade from this frame's depth at the map's pose):
+  // odometry points carry the drift of the frames that made them, and outnumbering the map they
+  // would keep it (measured on seq-a frames 300-599: 0.05 m instead of 0.015 m after the map is
+  // found again).
   bool map_only = false;
-  if (localize_only_) {
+  if (odometry_localisation_) {
     int in_map = 0;
     for (const auto& p : frame.map_points) in_map += p && p->NumObservations() > 0 && UsableForPose(*p);
     map_only = in_map >= options_.tracking.min_inliers;
@@ -606,7 +609,7 @@ bool Tracking::TrackLocalMap(Frame& frame) {
   matches_inliers_ = count_inliers();
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (p && !frame.outlier[i] && !localize_only_) ++p->found;
+    if (p && !frame.outlier[i] && !p->frozen) ++p->found;
   }
   const uint64_t reloc_window =
       static_cast<uint64_t>(options_.tracking.max_frames_between_keyframes);
@@ -654,7 +657,9 @@ int Tracking::JudgeStaticness(Frame& frame) {
     if (UsableForPose(*p)) continue;
     ++dynamic;
     frame.outlier[i] = true;
-    if (!localize_only_ && p->static_probability <= kCullProbability) {
+    // Never a loaded map's point (localisation only), nor an odometry point (not in the map).
+    if ((!localize_only_ || (!odometry_localisation_ && !p->frozen)) &&
+        p->static_probability <= kCullProbability) {
       cull.push_back(p.get());
       p.reset();
       frame.outlier[i] = false;
@@ -762,11 +767,17 @@ bool Tracking::Relocalise(Frame& frame) {
     ++recent;
     if (chosen.insert(it->first).second) candidates.push_back(it->second.get());
   }
-  const FrameFeatures& f = frame.F();
+  // Network depth: the pose optimisation rescales the frame's depths to the candidate's points
+  // (it replaces frame.features). Each candidate starts from the frame's own depths, and `f`
+  // stays valid: it used to dangle after a rejected candidate (use after free, a crash on seq-a
+  // FastDepth frames 0-299 localised in a map of 300-599).
+  const std::shared_ptr<const FrameFeatures> original = frame.features;
+  const FrameFeatures& f = *original;
   const Matcher matcher(0.75f, true);
   const cv::Mat K = (cv::Mat_<double>(3, 3) << f.intrinsics.fx, 0, f.intrinsics.cx, 0,
                      f.intrinsics.fy, f.intrinsics.cy, 0, 0, 1);
   for (KeyFrame* kf : candidates) {
+    frame.features = original;
     std::vector<std::shared_ptr<MapPoint>> matches;
     if (matcher.SearchByDescriptor(*kf, frame, matches) < 15) continue;
     std::vector<cv::Point3f> object;
@@ -811,6 +822,7 @@ bool Tracking::Relocalise(Frame& frame) {
   }
   std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
   frame.cam_from_world.reset();
+  frame.features = original;
   return false;
 }
 

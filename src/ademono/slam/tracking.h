@@ -153,6 +153,9 @@ class Tracking {
   int log_scale_count_ = 0;
   bool map_loaded_ = false;
   bool localize_only_ = false;
+  // Localisation only without a temporary map (tracking.temporary_map false): frame-to-frame
+  // odometry where the loaded map is out of view.
+  bool odometry_localisation_ = false;
   // Localisation-only mode (ORB-SLAM2's mbVO): the last frame tracked mostly on temporary
   // visual-odometry points (its own depth readings, never added to the map) because the map was
   // out of view; each such frame also tries relocalisation to get back onto the map.
