@@ -150,12 +150,13 @@ DynamicParams Params() {
 }
 
 TEST(RemoveDynamicPointsTest, JudgedSmallBoxesKeepPointsThatMoveWithTheCamera) {
-  // By default a small box is judged like a large one: its point moves like the background and
-  // stays kept (a far parked car); moved by (20, 1) it fails stage 1 (a far moving car).
+  // Judged like a large box (judge_small_boxes; off by default), a small box's point that moves
+  // like the background stays kept (a far parked car); moved by (20, 1) it fails stage 1 (a far
+  // moving car).
   Scene s;
   DynamicParams p = Params();
   p.judge_small_boxes = true;
-  EXPECT_TRUE(DynamicParams{}.judge_small_boxes);
+  EXPECT_FALSE(DynamicParams{}.judge_small_boxes);
   const DynamicResult r = RemoveDynamicPoints(s.Input(), p);
   EXPECT_EQ(r.labels[Scene::kSmallInside], PointLabel::kKept);
   // The background motion is the same: the small box's point is not background either way.

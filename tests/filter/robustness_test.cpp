@@ -20,10 +20,10 @@ TEST(FeatureFilterRobustnessTest, RandomInputsGiveValidLabels) {
   Camera camera = Camera::Pinhole(320, 240, 300, 160, 120);
   camera.distortion = {0.05, -0.01, 0.001, 0.0, 0.0};
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  // Both small-box rules: judged like large boxes (default) and dropped whole (the paper's).
-  FilterOptions paper_options;
-  paper_options.dynamic.judge_small_boxes = false;
-  FeatureFilter judging{FilterOptions{}}, paper{paper_options};
+  // Both small-box rules: judged like large boxes and dropped whole (the paper's, the default).
+  FilterOptions judging_options;
+  judging_options.dynamic.judge_small_boxes = true;
+  FeatureFilter judging{judging_options}, paper{FilterOptions{}};
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-0.2f, 1.2f), depth(-1.f, 60.f);
   std::array<int, kNumPointLabels> total{};  // over all trials, per label
