@@ -59,8 +59,10 @@ PY
 }
 
 run bonn_sensor_yolox "$bonn" sensor YOLOX-nano "boxes + geometry" --detector "$bonn_det"
-run bonn_sensor_yolox_twostage "$bonn" sensor YOLOX-nano "boxes (two-stage only)" \
-    --detector "$bonn_det" --set tracking.static_test=false
+run bonn_sensor_yolox_twostage "$bonn" sensor YOLOX-nano "boxes (the paper's rule alone)" \
+    --detector "$bonn_det" --set tracking.static_test=false --set filter.judge_small_boxes=false
+run bonn_sensor_yolox_judged "$bonn" sensor YOLOX-nano "boxes + geometry, small boxes judged" \
+    --detector "$bonn_det" --set filter.judge_small_boxes=true
 run bonn_sensor_geometry "$bonn" sensor none "geometry only"
 run bonn_sensor_none "$bonn" sensor none "none" --set tracking.static_test=false
 run bonn_fastdepth_yolox "$bonn" FastDepth YOLOX-nano "boxes + geometry" --depth "$fastdepth" \

@@ -3,7 +3,7 @@
 # actors (issue 17; docs/synth.md "Actor photos"): three seeds each, simulated network depth,
 # YOLOX-nano as the detector, compared with ground-truth boxes and with no dynamic removal.
 # Usage: tools/synthetic_dynamic_acceptance.sh [ADEMONO_BINARY] [WORK_DIR] [-- extra ablate args]
-#   OFFICE_SEEDS (7 5 11), STREET_SEEDS (1 2 3), OFFICE_FRAMES (300), STREET_FRAMES (150),
+#   OFFICE_SEEDS (7 5 11; empty: none), STREET_SEEDS (1 2 3), OFFICE_FRAMES (300), STREET_FRAMES (150),
 #   PHOTOS (../shared/images), MODEL (../shared/models/yolox_nano.onnx); SKIP_RUNS=1 only
 #   prints the table from earlier results in WORK_DIR.
 # Per sequence: `ademono synth --actor-photos`, `ademono recall` (YOLOX-nano's recall against the
@@ -21,8 +21,8 @@ shift $(( $# < 2 ? $# : 2 ))
 extra=("$@")
 photos="${PHOTOS:-$here/../shared/images}"
 model="${MODEL:-$here/../shared/models/yolox_nano.onnx}"
-office_seeds="${OFFICE_SEEDS:-7 5 11}"
-street_seeds="${STREET_SEEDS:-1 2 3}"
+office_seeds="${OFFICE_SEEDS-7 5 11}"
+street_seeds="${STREET_SEEDS-1 2 3}"
 mkdir -p "$work"
 
 run_one() {  # scene seed
@@ -102,4 +102,24 @@ for scene, seeds in (("office", office), ("street", street)):
             f(nodyn["ate_sim3_rmse_m"])))
 print()
 print("all criteria met" if ok_all else "NOT all criteria met")
+# Why: what removed the static keypoints, what the moving keypoints that were not removed are,
+# and how many moving keypoints the pose used (with YOLOX-nano, and with no dynamic removal).
+print()
+print("| scene | seed | static removed by: small box / stage 1 / stage 2 / box vote / geometry judged moving / geometry unconfirmed | static removed within 2 px of a mover | moving not removed: never matched / pose inlier / pose outlier | ... of them outside every YOLOX box / at the mover's outline | moving keypoints in the pose: yolox / no removal | pose inliers on static keypoints: yolox / no removal |")
+print("|---|---|---|---|---|---|---|---|")
+for scene, seeds in (("office", office), ("street", street)):
+    for seed in seeds:
+        base = os.path.join(work, "%s_s%s" % (scene, seed))
+        y = variants(base + "_yolox/ablation.json")
+        if not y or "static_removed_by" not in (y["full"]["truth"] or {}):
+            continue
+        t, tn = y["full"]["truth"], y["no_dynamic"]["truth"]
+        by, ms, ns = t["static_removed_by"], t["moving_kept_by_state"], tn["moving_kept_by_state"]
+        print("| %s | %s | %d / %d / %d / %d / %d / %d | %d | %d / %d / %d | %d / %d | %d / %d | %d / %d |" % (
+            scene, seed, by["small_box"], by["stage1"], by["stage2"], by["box_vote"],
+            by["geometric_judged_moving"], by["geometric_unconfirmed"],
+            t["static_at_mover_edge_removed"], ms["unmatched"], ms["pose_inlier"],
+            ms["pose_outlier"], t["moving_not_removed_unboxed"], t["moving_not_removed_at_edge"],
+            ms["pose_inlier"], ns["pose_inlier"], t["static_kept_by_state"]["pose_inlier"],
+            tn["static_kept_by_state"]["pose_inlier"]))
 PY

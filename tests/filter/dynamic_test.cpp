@@ -141,10 +141,36 @@ struct Scene {
   }
 };
 
+// The paper's rule: every point in a small box is dropped (the tests below check its branches).
 DynamicParams Params() {
   DynamicParams p;
   p.background_matches_t = 3;
+  p.judge_small_boxes = false;
   return p;
+}
+
+TEST(RemoveDynamicPointsTest, JudgedSmallBoxesKeepPointsThatMoveWithTheCamera) {
+  // Judged like a large box (judge_small_boxes; off by default), a small box's point that moves
+  // like the background stays kept (a far parked car); moved by (20, 1) it fails stage 1 (a far
+  // moving car).
+  Scene s;
+  DynamicParams p = Params();
+  p.judge_small_boxes = true;
+  EXPECT_FALSE(DynamicParams{}.judge_small_boxes);
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), p);
+  EXPECT_EQ(r.labels[Scene::kSmallInside], PointLabel::kKept);
+  // The background motion is the same: the small box's point is not background either way.
+  ASSERT_TRUE(r.background_motion.has_value());
+  EXPECT_NEAR(r.background_motion->x(), 2.0, 1e-9);
+  EXPECT_EQ(r.labels[Scene::kLargeStage1], PointLabel::kDynamicStage1);
+  s.prev[Scene::kSmallInside].pt -= cv::Point2f(18, 0);
+  s.previous.keypoints = s.prev;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[Scene::kSmallInside],
+            PointLabel::kDynamicStage1);
+  // Without a previous frame there is nothing to judge by: kept, like a large box's points.
+  DynamicInput first = s.Input();
+  first.previous = nullptr;
+  EXPECT_EQ(RemoveDynamicPoints(first, p).labels[Scene::kSmallInside], PointLabel::kKept);
 }
 
 TEST(RemoveDynamicPointsTest, EveryBranchGetsItsLabel) {

@@ -104,9 +104,16 @@ struct Frame {
   }
 };
 
+// The paper's small-box rule (drop every point inside), which these tests check.
+FilterOptions PaperSmallBoxes() {
+  FilterOptions o;
+  o.dynamic.judge_small_boxes = false;
+  return o;
+}
+
 TEST(FeatureFilterTest, FiltersApplyInOrderAndStatsAddUp) {
   const Frame f;
-  FeatureFilter filter{FilterOptions{}};
+  FeatureFilter filter{PaperSmallBoxes()};
   FilterStats stats;
   const std::vector<PointLabel> labels = filter.Apply(f.Input(), &stats);
   ASSERT_EQ(labels.size(), f.keypoints.size());
@@ -149,7 +156,7 @@ TEST(FeatureFilterTest, SameSeedSameLabelsAcrossFilters) {
 
 TEST(FeatureFilterTest, AblationSwitches) {
   const Frame f;
-  FilterOptions off;
+  FilterOptions off = PaperSmallBoxes();
   off.enable_enhancement = off.enable_dynamic_removal = off.enable_distant_filter = false;
   FeatureFilter none{off};
   for (PointLabel l : none.Apply(f.Input())) EXPECT_EQ(l, PointLabel::kKept);

@@ -20,7 +20,10 @@ TEST(FeatureFilterRobustnessTest, RandomInputsGiveValidLabels) {
   Camera camera = Camera::Pinhole(320, 240, 300, 160, 120);
   camera.distortion = {0.05, -0.01, 0.001, 0.0, 0.0};
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  FeatureFilter filter{FilterOptions{}};
+  // Both small-box rules: judged like large boxes and dropped whole (the paper's, the default).
+  FilterOptions judging_options;
+  judging_options.dynamic.judge_small_boxes = true;
+  FeatureFilter judging{judging_options}, paper{FilterOptions{}};
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-0.2f, 1.2f), depth(-1.f, 60.f);
   std::array<int, kNumPointLabels> total{};  // over all trials, per label
@@ -72,6 +75,7 @@ TEST(FeatureFilterRobustnessTest, RandomInputsGiveValidLabels) {
     in.previous = trial % 3 == 0 && !moving_box ? nullptr : &prev;
     if (trial % 2 == 0) in.predicted_cam_from_world = Rigid3d::Identity();
     FilterStats stats;
+    FeatureFilter& filter = trial % 4 < 2 ? judging : paper;
     const std::vector<PointLabel> labels = filter.Apply(in, &stats);
     ASSERT_EQ(labels.size(), kps.size());
     std::array<int, kNumPointLabels> count{};

@@ -151,6 +151,13 @@ TEST(AblationTest, AllVariantsAddBoxesOnlyAndGeometryOnly) {
   EXPECT_EQ(all[5].name, "boxes_only");
   EXPECT_TRUE(all[5].use_detector && all[5].dynamic_removal);
   EXPECT_FALSE(all[5].geometric_test);
+  // The paper's rule: small boxes dropped whole; every other variant judges them.
+  EXPECT_TRUE(all[5].paper_small_boxes);
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (i != 5) {
+      EXPECT_FALSE(all[i].paper_small_boxes) << all[i].name;
+    }
+  }
   EXPECT_EQ(all[6].name, "geometry_only");
   EXPECT_FALSE(all[6].use_detector);
   EXPECT_TRUE(all[6].geometric_test);

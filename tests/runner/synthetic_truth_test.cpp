@@ -66,20 +66,29 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   truth.Score(frame, {standing, parked, chair}, kps, labels, &unboxed);
   EXPECT_EQ(unboxed.moving_unboxed_keypoints, 2);
   EXPECT_EQ(unboxed.moving_unboxed_removed, 1);
-  // The geometric test keeping the moving keypoint 1 (labelled kept) and the static keypoint 5
-  // out of the pose counts as removing them.
-  const std::vector<uint8_t> rejected{0, 1, 0, 0, 0, 1, 0, 0, 0};
+  // The geometric test keeping the moving keypoint 1 (labelled kept; judged moving) and the
+  // static keypoint 5 (unconfirmed) out of the pose counts as removing them; a pose inlier or
+  // outlier does not.
+  using M = MatchState;
+  const std::vector<MatchState> states{M::kUnmatched,   M::kJudgedMoving, M::kUnmatched,
+                                       M::kPoseInlier,  M::kUnmatched,    M::kUnconfirmed,
+                                       M::kUnmatched,   M::kPoseOutlier,  M::kPoseInlier};
   TruthCounts geometric;
-  truth.Score(frame, {standing, parked, chair}, kps, labels, &geometric, &rejected);
+  truth.Score(frame, {standing, parked, chair}, kps, labels, &geometric, &states);
   EXPECT_EQ(geometric.moving_removed, 2);
   EXPECT_EQ(geometric.moving_unboxed_removed, 2);
+  EXPECT_EQ(geometric.moving_not_removed_unboxed, 0);
   EXPECT_EQ(geometric.static_removed, unboxed.static_removed + 1);
   // What removed them: the box filter's labels first, the geometric test only where none.
   EXPECT_EQ(geometric.static_removed_box_vote, 1);
   EXPECT_EQ(geometric.static_removed_small_box, 1);
   EXPECT_EQ(geometric.static_removed_stage1, 0);
-  EXPECT_EQ(geometric.static_removed_geometric, 1);
+  EXPECT_EQ(geometric.static_removed_unconfirmed, 1);
+  EXPECT_EQ(geometric.static_removed_judged_moving, 0);
   EXPECT_EQ(geometric.moving_removed_geometric, 1);
+  // The kept keypoints by state: static 3 (inlier), 5 (unconfirmed), 7 (outlier), 8 (inlier).
+  EXPECT_EQ(geometric.static_kept_by_state, (TruthCounts::StateCounts{0, 2, 1, 1, 0}));
+  EXPECT_EQ(geometric.moving_kept_by_state, (TruthCounts::StateCounts{0, 0, 0, 0, 1}));
   EXPECT_EQ(geometric.static_at_mover_edge_keypoints, 0);
   // A corner just outside the mover's outline (x = 51, 2 px from its last pixel) is static but
   // at the mover's edge; 3 px away it is not.

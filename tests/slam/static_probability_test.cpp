@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "ademono/slam/system.h"
@@ -108,6 +109,35 @@ TEST(StaticProbabilityTest, BoxlessMoversAreJudgedMoving) {
   EXPECT_GT(on.judged_dynamic, 0);  // the persons' points are caught without a box
   EXPECT_EQ(off.judged_dynamic, 0);
   EXPECT_GE(on.tracked, 60);
+}
+
+// What tracking reports per keypoint (MatchState) covers the frame's matches only: its pose
+// inliers are the frame's inlier count, and what the geometric test keeps out of the pose is what
+// it judged below the threshold this frame; a new keyframe's own fresh points (at the creation
+// prior, never matched) are not among them.
+TEST(StaticProbabilityTest, MatchStatesCountTheFramesMatchesOnly) {
+  const SyntheticOffice sequence(30, 320, 240, 7, 2);
+  SystemOptions options;
+  options.tracking.static_test = true;
+  System system(sequence.GetCamera(), options);
+  int keyframes_checked = 0;
+  for (size_t i = 0; i < sequence.Size(); ++i) {
+    const FrameData frame = sequence.Load(i);
+    const TrackResult r = system.TrackFrame(frame, frame.depth, {});
+    if (!r.tracked || i == 0) continue;
+    ASSERT_EQ(r.match_state.size(), r.keypoints.size());
+    std::array<int, 5> count{};
+    for (MatchState s : r.match_state) ++count[static_cast<size_t>(s)];
+    if (r.quality != PoseQuality::kGood) continue;
+    EXPECT_EQ(count[static_cast<size_t>(MatchState::kPoseInlier)], r.inliers) << "frame " << i;
+    EXPECT_LE(count[static_cast<size_t>(MatchState::kUnconfirmed)] +
+                  count[static_cast<size_t>(MatchState::kJudgedMoving)],
+              r.geometric_dynamic)
+        << "frame " << i;
+    keyframes_checked += r.new_keyframe;
+  }
+  system.Shutdown();
+  EXPECT_GT(keyframes_checked, 0);
 }
 
 }  // namespace

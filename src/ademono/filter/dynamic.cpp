@@ -101,13 +101,15 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
                                     cv::Size(input.camera->width, input.camera->height), params);
   if (result.boxes.empty()) return result;
 
-  // Which box class each point falls in: a small box wins over a large one.
+  // Which box class each point falls in: a small box wins over a large one. Judged small boxes
+  // go through the large boxes' tests.
+  auto dropped_whole = [&](const GrownBox& b) { return b.small && !params.judge_small_boxes; };
   std::vector<char> in_small(n, 0), in_large(n, 0), in_any(n, 0);
   for (size_t i = 0; i < n; ++i) {
     for (const GrownBox& b : result.boxes) {
       if (!InsideBox(b.box, kps[i].pt)) continue;
       in_any[i] = 1;
-      (b.small ? in_small[i] : in_large[i]) = 1;
+      (dropped_whole(b) ? in_small[i] : in_large[i]) = 1;
     }
   }
   bool any_large = false;
@@ -257,7 +259,7 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
     std::vector<char> moving_box(result.boxes.size(), 0);
     std::vector<double> mover_depth(result.boxes.size(), 0.0);  // 0: unknown
     for (size_t b = 0; b < result.boxes.size(); ++b) {
-      if (result.boxes[b].small) continue;
+      if (dropped_whole(result.boxes[b])) continue;
       int num_judged = 0, num_dynamic = 0;
       std::vector<float> failed_depths;
       for (size_t i = 0; i < n; ++i) {

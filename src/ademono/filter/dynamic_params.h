@@ -13,7 +13,12 @@ class OptionsTable;
 
 struct DynamicParams {
   double box_growth = 0.02;            // d = box_growth * box diagonal on every side
-  double small_box_area_ratio = 0.05;  // box area / image area below this: drop all inside
+  double small_box_area_ratio = 0.05;  // box area / image area below this: a small target
+  // true: small targets go through stage 1/2 and the box vote like large ones (a far parked car
+  // whose points agree with the camera motion keeps them). false (default): the paper's rule,
+  // every point in a small box is dropped (kDynamicSmallBox). Off by default: on the synthetic
+  // street ring the kept parked-car points ruined the loop correction (docs/filters.md).
+  bool judge_small_boxes = false;
   int background_matches_t = 20;       // t smallest-Hamming background matches
   double d_dis_px = 8.0;               // stage 1 threshold D_dis (pixels)
   double d_min_px = 4.0;               // stage 2 threshold D_min (pixels)

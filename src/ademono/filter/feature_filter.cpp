@@ -44,6 +44,7 @@ const OptionsTable<DynamicParams>& DynamicParams::Table() {
       OptionsTable<P>("filter")
           .Add("box_growth", &P::box_growth, Range::Closed(0, 1))
           .Add("small_box_area_ratio", &P::small_box_area_ratio, Range::Closed(0, 1))
+          .Add("judge_small_boxes", &P::judge_small_boxes)
           .Add("background_matches_t", &P::background_matches_t, Range::AtLeast(1))
           .Add("d_dis_px", &P::d_dis_px, Range::Above(0))
           .Add("d_min_px", &P::d_min_px, Range::Above(0))

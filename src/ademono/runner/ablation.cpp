@@ -25,7 +25,7 @@ const std::vector<AblationVariant>& DefaultAblationVariants() {
 const std::vector<AblationVariant>& AllAblationVariants() {
   static const std::vector<AblationVariant> variants = [] {
     std::vector<AblationVariant> v = DefaultAblationVariants();
-    v.push_back({"boxes_only", true, true, true, false, true});
+    v.push_back({"boxes_only", true, true, true, false, true, true});
     v.push_back({"geometry_only", true, true, true, true, false});
     return v;
   }();
@@ -42,7 +42,8 @@ nlohmann::json VariantResult::ToJson() const {
                   {"dynamic_removal", variant.dynamic_removal},
                   {"distant", variant.distant_filter},
                   {"geometric_test", variant.geometric_test},
-                  {"detector", variant.use_detector}};
+                  {"detector", variant.use_detector},
+                  {"paper_small_boxes", variant.paper_small_boxes}};
   j["frames"] = frames;
   j["tracked"] = tracked;
   j["tracking_rate"] = frames > 0 ? static_cast<double>(tracked) / frames : 0.0;
@@ -68,6 +69,7 @@ VariantResult RunAblationVariant(const Sequence& sequence, DepthProvider* depth,
   run.system.filter.enable_dynamic_removal = variant.dynamic_removal;
   run.system.filter.enable_distant_filter = variant.distant_filter;
   run.system.tracking.static_test = variant.geometric_test;
+  if (variant.paper_small_boxes) run.system.filter.dynamic.judge_small_boxes = false;
   run.pipeline = options.pipeline;
   run.dataset = options.dataset;
   run.config = options.config;

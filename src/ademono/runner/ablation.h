@@ -32,11 +32,14 @@ struct AblationVariant {
   // switch it off with the box filter, so that they measure no dynamic handling at all.
   bool geometric_test = true;
   bool use_detector = true;  // false: the run sees no detections (geometry only)
+  // The paper's small-box rule (every point in a small box dropped) instead of judging small boxes
+  // like large ones (filter.judge_small_boxes).
+  bool paper_small_boxes = false;
 };
 // full, no_dynamic, no_distant, no_dynamic_no_distant, no_enhancement.
 const std::vector<AblationVariant>& DefaultAblationVariants();
-// The defaults plus boxes_only (the detector's boxes through the paper's two-stage rule, no
-// geometric test) and geometry_only (no detections, the geometric test alone): with a real
+// The defaults plus boxes_only (the detector's boxes through the paper's rule: small boxes dropped,
+// the two-stage test in large ones, no geometric test) and geometry_only (no detections, the geometric test alone): with a real
 // detector (`--detector model:...`) these compare what the boxes and the geometry each bring.
 const std::vector<AblationVariant>& AllAblationVariants();
 

@@ -165,7 +165,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     report.per_frame.push_back(f);
     report.filter_totals.Add(r.filter_stats, r.num_keypoints);
     if (score)
-      truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.geometric_rejected);
+      truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.match_state);
     if (options.on_frame) options.on_frame(frame, detections, r);
   };
   std::unique_ptr<RealtimeFeed> feed;

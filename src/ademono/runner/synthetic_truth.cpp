@@ -17,6 +17,13 @@ nlohmann::json TruthCounts::ToJson() const {
   auto ratio = [](long long a, long long b) {
     return b > 0 ? nlohmann::json(static_cast<double>(a) / b) : nlohmann::json(nullptr);
   };
+  auto states = [](const StateCounts& c) {
+    return nlohmann::json{{"unmatched", c[0]},
+                          {"pose_inlier", c[1]},
+                          {"pose_outlier", c[2]},
+                          {"unconfirmed", c[3]},
+                          {"judged_moving", c[4]}};
+  };
   return {{"moving_keypoints", moving_keypoints},
           {"moving_removed", moving_removed},
           {"moving_kept", moving_kept},
@@ -38,7 +45,12 @@ nlohmann::json TruthCounts::ToJson() const {
             {"stage1", static_removed_stage1},
             {"stage2", static_removed_stage2},
             {"box_vote", static_removed_box_vote},
-            {"geometric", static_removed_geometric}}},
+            {"geometric_unconfirmed", static_removed_unconfirmed},
+            {"geometric_judged_moving", static_removed_judged_moving}}},
+          {"static_kept_by_state", states(static_kept_by_state)},
+          {"moving_kept_by_state", states(moving_kept_by_state)},
+          {"moving_not_removed_at_edge", moving_not_removed_at_edge},
+          {"moving_not_removed_unboxed", moving_not_removed_unboxed},
           {"static_at_mover_edge_keypoints", static_at_mover_edge_keypoints},
           {"static_at_mover_edge_removed", static_at_mover_edge_removed},
           {"moving_removed_geometric", moving_removed_geometric}};
@@ -60,7 +72,7 @@ cv::Point Pixel(const cv::KeyPoint& kp, const cv::Size& size) {
 void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>& detections,
                            const std::vector<cv::KeyPoint>& keypoints,
                            const std::vector<PointLabel>& labels, TruthCounts* counts,
-                           const std::vector<uint8_t>* geometric_rejected) const {
+                           const std::vector<MatchState>* match_state) const {
   const fs::path path = masks_dir_ / (frame.name + ".png");
   RequireFile(path);
   const cv::Mat mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
@@ -81,15 +93,20 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       static_box = box;
     }
   }
-  cv::Mat near_mover;  // moving pixels grown by 2 px
-  cv::dilate(mask > 127, near_mover, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  cv::Mat near_mover, near_static;  // moving (static) pixels grown by 2 px
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
+  cv::dilate(mask > 127, near_mover, kernel);
+  cv::dilate(mask <= 127, near_static, kernel);
   for (size_t i = 0; i < keypoints.size() && i < labels.size(); ++i) {
     const cv::Point p = Pixel(keypoints[i], mask.size());
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
     if (labels[i] == PointLabel::kEnhancementDropped) continue;
-    const bool dynamic =
-        IsDynamic(labels[i]) || (geometric_rejected && i < geometric_rejected->size() &&
-                                 (*geometric_rejected)[i] != 0);
+    const MatchState state = match_state && i < match_state->size() ? (*match_state)[i]
+                                                                     : MatchState::kUnmatched;
+    const bool geometric =
+        state == MatchState::kUnconfirmed || state == MatchState::kJudgedMoving;
+    const bool dynamic = IsDynamic(labels[i]) || geometric;
+    const auto state_index = static_cast<size_t>(state);
     const auto& classes = DefaultDynamicClassIds();
     const bool in_box = std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
       return std::find(classes.begin(), classes.end(), d.class_id) != classes.end() &&
@@ -100,15 +117,25 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;
       if (geometric_only) ++counts->moving_removed_geometric;
-      if (labels[i] == PointLabel::kKept) ++counts->moving_kept;
+      if (labels[i] == PointLabel::kKept) {
+        ++counts->moving_kept;
+        ++counts->moving_kept_by_state[state_index];
+      }
       if (!in_box) {
         ++counts->moving_unboxed_keypoints;
         if (dynamic) ++counts->moving_unboxed_removed;
       }
+      if (!dynamic) {
+        if (near_static.at<uint8_t>(p) != 0) ++counts->moving_not_removed_at_edge;
+        if (!in_box) ++counts->moving_not_removed_unboxed;
+      }
     } else {
       ++counts->static_keypoints;
       if (dynamic) ++counts->static_removed;
-      if (geometric_only) ++counts->static_removed_geometric;
+      if (labels[i] == PointLabel::kKept) ++counts->static_kept_by_state[state_index];
+      if (geometric_only && state == MatchState::kUnconfirmed) ++counts->static_removed_unconfirmed;
+      if (geometric_only && state == MatchState::kJudgedMoving)
+        ++counts->static_removed_judged_moving;
       if (near_mover.at<uint8_t>(p) != 0) {
         ++counts->static_at_mover_edge_keypoints;
         if (dynamic) ++counts->static_at_mover_edge_removed;

@@ -64,13 +64,12 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.quality = out.quality;
   result.geometric_dynamic = out.geometric_dynamic;
   result.geometric_culled = out.geometric_culled;
-  if (!out.geometric_rejected.empty()) {
+  if (!out.match_state.empty()) {
     // Back from the kept keypoints (the features) to all extracted keypoints.
-    result.geometric_rejected.assign(extracted.keypoints.size(), 0);
+    result.match_state.assign(extracted.keypoints.size(), MatchState::kUnmatched);
     for (size_t i = 0, k = 0; i < extracted.keypoints.size(); ++i) {
       if (filtered.labels[i] != PointLabel::kKept) continue;
-      if (k < out.geometric_rejected.size())
-        result.geometric_rejected[i] = out.geometric_rejected[k];
+      if (k < out.match_state.size()) result.match_state[i] = out.match_state[k];
       ++k;
     }
   }

@@ -41,9 +41,9 @@ struct TrackResult {
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)
-  // ... and per keypoint 1 when it was kept by the filter but matched a map point the geometric
-  // test keeps out of the pose (empty when the test is off or the frame is untracked).
-  std::vector<uint8_t> geometric_rejected;
+  // ... and per keypoint what tracking made of it (kUnmatched for keypoints the filter removed;
+  // empty when the frame is untracked).
+  std::vector<MatchState> match_state;
   // Wall milliseconds per stage. extraction (grey + ORB) and keypoint_depth come from wherever
   // the frame was extracted (the pipeline's prefetch thread, or TrackFrame itself).
   double extraction_ms = 0, keypoint_depth_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;

@@ -219,6 +219,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       lost_streak_ = 0;
       weak_streak_ = weak ? weak_streak_ + 1 : 0;
       if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
+      out.match_state = MatchStates(frame);
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
@@ -265,13 +266,6 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.inliers = matches_inliers_;
     out.geometric_dynamic = judged_dynamic_;
     out.geometric_culled = geometric_culled_;
-    if (options_.tracking.static_test) {
-      out.geometric_rejected.assign(frame.map_points.size(), 0);
-      for (size_t i = 0; i < frame.map_points.size(); ++i) {
-        const auto& p = frame.map_points[i];
-        if (p && !UsableForPose(*p)) out.geometric_rejected[i] = 1;
-      }
-    }
     out.depth_scale = record.depth_scale = frame.F().depth_scale;
     if (frame.F().DepthIsPrior()) {
       last_depth_scale_ = frame.F().depth_scale;
@@ -618,6 +612,24 @@ bool Tracking::TrackLocalMap(Frame& frame) {
     return false;
   }
   return matches_inliers_ >= options_.tracking.min_inliers;
+}
+
+std::vector<MatchState> Tracking::MatchStates(const Frame& frame) const {
+  const StaticTestParams& params = options_.tracking.static_params;
+  std::vector<MatchState> states(frame.map_points.size(), MatchState::kUnmatched);
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad) continue;
+    if (!UsableForPose(*p)) {
+      // Still at the prior it was created with: never judged decisively.
+      const bool unconfirmed = p->static_probability == params.prior ||
+                               p->static_probability == params.box_prior;
+      states[i] = unconfirmed ? MatchState::kUnconfirmed : MatchState::kJudgedMoving;
+    } else {
+      states[i] = frame.outlier[i] ? MatchState::kPoseOutlier : MatchState::kPoseInlier;
+    }
+  }
+  return states;
 }
 
 bool Tracking::UsableForPose(const MapPoint& point) const {

@@ -32,6 +32,19 @@ enum class PoseQuality { kGood, kFewInliers, kMotionModel };
 // "good" | "few_static_points" | "motion_model" (summary.json per_frame, report.html).
 const char* PoseQualityName(PoseQuality quality);
 
+// What became of one keypoint of a tracked frame in the pose (for scoring against synthetic
+// truth; TrackingOutput::match_state): no map point matched it; it matched one and was a pose
+// inlier, or rejected by the pose's robust test; or the geometric test kept its map point out of
+// the pose, either still unconfirmed (a new point at its creation prior, no decisive verdict yet)
+// or judged moving (motion evidence brought it below the threshold).
+enum class MatchState : uint8_t {
+  kUnmatched = 0,
+  kPoseInlier = 1,
+  kPoseOutlier = 2,
+  kUnconfirmed = 3,
+  kJudgedMoving = 4
+};
+
 // What the trajectory needs of each input frame: its pose relative to a keyframe, so that later
 // keyframe corrections (local BA, culling) move it along.
 struct FrameRecord {
@@ -56,9 +69,9 @@ struct TrackingOutput {
   // map points culled for falling to the floor probability.
   int geometric_dynamic = 0;
   int geometric_culled = 0;
-  // Per keypoint of the frame's features (tracked frames, geometric test on; else empty): 1 when
-  // it matched a map point the test keeps out of the pose (P(static) below the threshold).
-  std::vector<uint8_t> geometric_rejected;
+  // Per keypoint of the frame's features (tracked frames; else empty): what the tracking made of
+  // it, taken before a new keyframe adds this frame's own points (those were not matched).
+  std::vector<MatchState> match_state;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
 };
 
@@ -113,6 +126,8 @@ class Tracking {
   int CountDepthPoints(const Frame& frame) const;
   // Geometric test: whether a map point's static probability lets it into the pose.
   bool UsableForPose(const MapPoint& point) const;
+  // Per keypoint of the frame: what tracking made of it (TrackingOutput::match_state).
+  std::vector<MatchState> MatchStates(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
   // Judges every matched map point at the frame's pose, updates its static probability, marks
   // the ones below the threshold as outliers and culls the ones at the floor. Returns how many
   // are below the threshold.
