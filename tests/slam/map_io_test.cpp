@@ -79,6 +79,23 @@ Rigid3d GroundTruthInFirstSession(const Sequence& full, size_t i) {
   return full.Load(0).world_from_cam_gt->inverse() * *full.Load(i).world_from_cam_gt;
 }
 
+// Largest position error of a second-session trajectory starting at frame `first`, in the first
+// session's frame (no alignment: the loaded map fixes it).
+double WorstErrorInFirstSession(const Sequence& full, size_t first, const Trajectory& trajectory) {
+  double worst = 0;
+  for (size_t k = 0; k < trajectory.size(); ++k) {
+    const Rigid3d gt = GroundTruthInFirstSession(full, first + k);
+    worst = std::max(worst, (gt.translation() - trajectory[k].world_from_cam.translation()).norm());
+  }
+  return worst;
+}
+
+void ExpectSameTrajectory(const Trajectory& a, const Trajectory& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i)
+    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+}
+
 TEST_F(MapIoTest, SaveLoadSaveIsByteIdentical) {
   const MapFileData data = LoadMapFile(MapPath());
   EXPECT_EQ(data.keyframes.size(), keyframes_);
@@ -118,16 +135,8 @@ TEST_F(MapIoTest, LocalizeOnlyRelocalisesEveryFrameAndNeverChangesTheMap) {
   };
   const Trajectory a = run();
   ASSERT_EQ(a.size(), 30u);
-  double worst = 0;
-  for (size_t k = 0; k < a.size(); ++k) {
-    const Rigid3d gt = GroundTruthInFirstSession(*full, 60 + k);
-    worst = std::max(worst, (gt.translation() - a[k].world_from_cam.translation()).norm());
-  }
-  EXPECT_LT(worst, 0.05);  // in the first session's frame, no alignment
-  const Trajectory b = run();
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i)
-    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+  EXPECT_LT(WorstErrorInFirstSession(*full, 60, a), 0.05);  // no alignment
+  ExpectSameTrajectory(a, run());
   EXPECT_TRUE(ReadBytes(MapPath()) == before);
 }
 
@@ -188,16 +197,8 @@ TEST_F(MapIoTest, TemporaryMapLocalisationNeverChangesTheLoadedMap) {
   };
   const Trajectory a = run();
   ASSERT_EQ(a.size(), 60u);
-  double worst = 0;
-  for (size_t k = 0; k < a.size(); ++k) {
-    const Rigid3d gt = GroundTruthInFirstSession(*full, 60 + k);
-    worst = std::max(worst, (gt.translation() - a[k].world_from_cam.translation()).norm());
-  }
-  EXPECT_LT(worst, 0.05);  // in the first session's frame, no alignment
-  const Trajectory b = run();
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i)
-    EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
+  EXPECT_LT(WorstErrorInFirstSession(*full, 60, a), 0.05);  // no alignment
+  ExpectSameTrajectory(a, run());
   EXPECT_TRUE(ReadBytes(MapPath()) == before);
 }
 
