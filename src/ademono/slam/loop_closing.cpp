@@ -347,7 +347,16 @@ void LoopClosing::FinishGlobalBundleAdjustment() {
   EndGlobalBundleAdjustment(true, last);
 }
 
-void LoopClosing::StartGlobalBundleAdjustment(size_t event) {
+void LoopClosing::GlobalBundleAdjustmentNow() {
+  FinishGlobalBundleAdjustment();
+  StartGlobalBundleAdjustment(std::nullopt);
+  if (!global_ba_) return;
+  uint64_t last = 0;
+  for (const auto& [id, kf] : map_.KeyFrames()) last = std::max(last, id);
+  EndGlobalBundleAdjustment(true, last);
+}
+
+void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
   auto job = std::make_unique<GlobalBa>();
   job->event = event;
   BundleAdjustmentProblem& problem = job->problem;
@@ -374,10 +383,12 @@ void LoopClosing::StartGlobalBundleAdjustment(size_t event) {
     problem.points.push_back(p->position);
     job->points.push_back(p);
   }
-  LoopEvent& e = events_[event];
-  e.global_ba = true;
-  e.global_ba_keyframes = problem.cameras.size();
-  e.global_ba_points = problem.points.size();
+  if (event) {
+    LoopEvent& e = events_[*event];
+    e.global_ba = true;
+    e.global_ba_keyframes = problem.cameras.size();
+    e.global_ba_points = problem.points.size();
+  }
   if (problem.cameras.size() < 2 || problem.points.empty()) return;
   BundleAdjustmentOptions ba;
   ba.first_iterations = options_.global_ba_iterations;
@@ -400,7 +411,8 @@ void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
   std::unique_ptr<GlobalBa> job = std::move(global_ba_);
   job->worker.join();
   if (job->failure) std::rethrow_exception(job->failure);
-  LoopEvent& e = events_[job->event];
+  LoopEvent none;  // the global BA before a save belongs to no loop
+  LoopEvent& e = job->event ? events_[*job->event] : none;
   e.global_ba_ms = job->ms;
   if (!apply) {
     spdlog::info("global BA after the loop at keyframe {} dropped: a newer loop came first",
@@ -448,10 +460,15 @@ void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
   }
   e.global_ba_merged = true;
   e.global_ba_merged_at_keyframe = at_keyframe;
-  spdlog::info("global BA after the loop at keyframe {}: {} keyframes, {} points, {:.0f} ms, "
-               "merged at keyframe {}",
-               e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
-               at_keyframe);
+  if (job->event) {
+    spdlog::info("global BA after the loop at keyframe {}: {} keyframes, {} points, {:.0f} ms, "
+                 "merged at keyframe {}",
+                 e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
+                 at_keyframe);
+  } else {
+    spdlog::info("global BA before saving the map: {} keyframes, {} points, {:.0f} ms",
+                 job->keyframes.size(), job->points.size(), job->ms);
+  }
   map_.NoteLoopCorrection();  // tracking follows its reference keyframe
 }
 

@@ -186,6 +186,9 @@ struct LoopOptions {
   bool global_ba = false;
   int global_ba_iterations = 10;
   int global_ba_handoff_keyframes = 2;
+  // A global bundle adjustment of the whole map before `--save-map` writes it (the run's
+  // trajectory follows it): the map a later session inherits (docs/maps.md).
+  bool global_ba_on_save = false;
   bool UseSim3(bool depth_is_prior) const {
     return transform == "sim3" || (transform == "auto" && depth_is_prior);
   }
