@@ -96,6 +96,41 @@ void ExpectSameTrajectory(const Trajectory& a, const Trajectory& b) {
     EXPECT_TRUE(a[i].world_from_cam.matrix() == b[i].world_from_cam.matrix()) << i;
 }
 
+// loop.global_ba_on_save: the map is refined by a global bundle adjustment before it is written,
+// the same way every time, and the run's trajectory follows it.
+TEST_F(MapIoTest, GlobalBundleAdjustmentOnSaveRefinesTheSavedMapDeterministically) {
+  const auto sequence = Slice(0, 60);
+  SystemOptions options = TestOptions();
+  options.loop.global_ba_on_save = true;
+  std::vector<std::string> bytes;
+  std::vector<Trajectory> keyframes;
+  for (int rep = 0; rep < 2; ++rep) {
+    System system(sequence->GetCamera(), options);
+    Track(system, *sequence);
+    const fs::path path = *dir_ / ("on_save_" + std::to_string(rep) + ".map");
+    system.SaveMap(path);
+    EXPECT_EQ(system.NumKeyFrames(), keyframes_);
+    bytes.push_back(ReadBytes(path));
+    keyframes.push_back(system.KeyFrameTrajectory());
+  }
+  EXPECT_EQ(bytes[0], bytes[1]);
+  EXPECT_NE(bytes[0], ReadBytes(MapPath()));  // the map without it (same frames and options)
+  // The refined keyframes moved, and by little: the local BAs had done most of the work.
+  System plain(sequence->GetCamera(), TestOptions());
+  Track(plain, *sequence);
+  const Trajectory before = plain.KeyFrameTrajectory();
+  ASSERT_EQ(before.size(), keyframes[0].size());
+  double moved = 0;
+  for (size_t k = 0; k < before.size(); ++k) {
+    moved = std::max(moved, (before[k].world_from_cam.translation() -
+                             keyframes[0][k].world_from_cam.translation())
+                                .norm());
+  }
+  EXPECT_GT(moved, 1e-6);
+  EXPECT_LT(moved, 0.05);
+  ExpectSameTrajectory(keyframes[0], keyframes[1]);
+}
+
 TEST_F(MapIoTest, SaveLoadSaveIsByteIdentical) {
   const MapFileData data = LoadMapFile(MapPath());
   EXPECT_EQ(data.keyframes.size(), keyframes_);

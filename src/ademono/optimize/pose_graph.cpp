@@ -43,7 +43,7 @@ namespace {
 // a perfect fit, as (2 * vec(q_E), t_E, log s_E). Per vertex: quaternion (x, y, z, w, Eigen
 // order), translation, log scale.
 struct Sim3EdgeCost {
-  explicit Sim3EdgeCost(const Sim3d& measured) {
+  Sim3EdgeCost(const Sim3d& measured, const Eigen::Matrix<double, 7, 1>& w) : weight(w) {
     const Sim3d inv = measured.Inverse();
     inv_scale = inv.scale;
     inv_rotation = inv.rotation;
@@ -73,8 +73,10 @@ struct Sim3EdgeCost {
     residual[4] = te.y();
     residual[5] = te.z();
     residual[6] = li[0] - lj[0] + T(std::log(inv_scale));
+    for (int k = 0; k < 7; ++k) residual[k] *= T(weight[k]);
     return true;
   }
+  Eigen::Matrix<double, 7, 1> weight;
   double inv_scale = 1;
   Eigen::Quaterniond inv_rotation;
   Eigen::Vector3d inv_translation;
@@ -172,7 +174,7 @@ PoseGraphResult SolvePoseGraph(const PoseGraphProblem& problem) {
   }
   for (const PoseGraphEdge& e : problem.edges) {
     auto* cost = new ceres::AutoDiffCostFunction<Sim3EdgeCost, 7, 4, 3, 1, 4, 3, 1>(
-        new Sim3EdgeCost(e.i_from_j));
+        new Sim3EdgeCost(e.i_from_j, e.sqrt_information));
     ceres_problem.AddResidualBlock(cost, nullptr, q[e.i].data(), t[e.i].data(), &log_s[e.i],
                                    q[e.j].data(), t[e.j].data(), &log_s[e.j]);
   }

@@ -1,8 +1,9 @@
 #pragma once
 // Pose-graph optimisation over similarity transforms (ORB-SLAM's OptimizeEssentialGraph) with
 // Ceres: one Sim(3) vertex per keyframe (cam_from_world), one relative-pose edge per graph link,
-// identity information as ORB-SLAM. With `fix_scale` every scale stays at its start value, which
-// is SE(3) pose-graph optimisation (sensor depth: metric scale is observed, it cannot drift).
+// identity information unless an edge carries its own (diagonal). With `fix_scale` every scale
+// stays at its start value, which is SE(3) pose-graph optimisation (sensor depth: metric scale
+// is observed, it cannot drift).
 // Single-threaded with blocks added in vertex order: identical results run to run.
 
 #include <Eigen/Core>
@@ -34,6 +35,8 @@ struct Sim3d {
 struct PoseGraphEdge {
   size_t i = 0, j = 0;  // vertex indices
   Sim3d i_from_j;       // measured relative pose: cam_i_from_cam_j
+  // Square-root information (diagonal) of the residual (rotation x3, translation x3, log scale).
+  Eigen::Matrix<double, 7, 1> sqrt_information = Eigen::Matrix<double, 7, 1>::Ones();
 };
 
 struct PoseGraphProblem {

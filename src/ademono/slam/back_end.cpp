@@ -98,6 +98,10 @@ void BackEnd::SaveMap(const std::filesystem::path& path) {
   MapFileData data;
   {
     MutexLock lock(map_.mutex);
+    if (loop_closing_ && options_.loop.global_ba_on_save) {
+      loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
+      loop_closing_->GlobalBundleAdjustmentNow();
+    }
     data = MapToRecords(map_, camera_, options_);
   }
   SaveMapFile(path, data);

@@ -66,6 +66,32 @@ double RotationDegrees(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
 }
 
+double Median(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Median depth of each keyframe's map points in its camera; a keyframe without any (or only
+// points behind it) takes the median of the others, and 1 m if no keyframe has one.
+std::vector<double> SceneDepths(const std::vector<KeyFrame*>& keyframes) {
+  std::vector<double> depth(keyframes.size(), 0.0), known;
+  for (size_t k = 0; k < keyframes.size(); ++k) {
+    std::vector<double> z;
+    for (const auto& p : keyframes[k]->map_points) {
+      if (!p || p->bad) continue;
+      const double d = (keyframes[k]->cam_from_world * p->position).z();
+      if (d > 0.0 && std::isfinite(d)) z.push_back(d);
+    }
+    if (!z.empty()) known.push_back(depth[k] = Median(std::move(z)));
+  }
+  const double fallback = known.empty() ? 1.0 : Median(known);
+  for (double& d : depth) {
+    if (d <= 0.0) d = fallback;
+  }
+  return depth;
+}
+
 }  // namespace
 
 LoopClosing::LoopClosing(Map& map, const KeyFrameDatabase& database, const LoopOptions& options,
@@ -321,7 +347,16 @@ void LoopClosing::FinishGlobalBundleAdjustment() {
   EndGlobalBundleAdjustment(true, last);
 }
 
-void LoopClosing::StartGlobalBundleAdjustment(size_t event) {
+void LoopClosing::GlobalBundleAdjustmentNow() {
+  FinishGlobalBundleAdjustment();
+  StartGlobalBundleAdjustment(std::nullopt);
+  if (!global_ba_) return;
+  uint64_t last = 0;
+  for (const auto& [id, kf] : map_.KeyFrames()) last = std::max(last, id);
+  EndGlobalBundleAdjustment(true, last);
+}
+
+void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
   auto job = std::make_unique<GlobalBa>();
   job->event = event;
   BundleAdjustmentProblem& problem = job->problem;
@@ -348,10 +383,12 @@ void LoopClosing::StartGlobalBundleAdjustment(size_t event) {
     problem.points.push_back(p->position);
     job->points.push_back(p);
   }
-  LoopEvent& e = events_[event];
-  e.global_ba = true;
-  e.global_ba_keyframes = problem.cameras.size();
-  e.global_ba_points = problem.points.size();
+  if (event) {
+    LoopEvent& e = events_[*event];
+    e.global_ba = true;
+    e.global_ba_keyframes = problem.cameras.size();
+    e.global_ba_points = problem.points.size();
+  }
   if (problem.cameras.size() < 2 || problem.points.empty()) return;
   BundleAdjustmentOptions ba;
   ba.first_iterations = options_.global_ba_iterations;
@@ -374,7 +411,8 @@ void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
   std::unique_ptr<GlobalBa> job = std::move(global_ba_);
   job->worker.join();
   if (job->failure) std::rethrow_exception(job->failure);
-  LoopEvent& e = events_[job->event];
+  LoopEvent none;  // the global BA before a save belongs to no loop
+  LoopEvent& e = job->event ? events_[*job->event] : none;
   e.global_ba_ms = job->ms;
   if (!apply) {
     spdlog::info("global BA after the loop at keyframe {} dropped: a newer loop came first",
@@ -422,10 +460,15 @@ void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
   }
   e.global_ba_merged = true;
   e.global_ba_merged_at_keyframe = at_keyframe;
-  spdlog::info("global BA after the loop at keyframe {}: {} keyframes, {} points, {:.0f} ms, "
-               "merged at keyframe {}",
-               e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
-               at_keyframe);
+  if (job->event) {
+    spdlog::info("global BA after the loop at keyframe {}: {} keyframes, {} points, {:.0f} ms, "
+                 "merged at keyframe {}",
+                 e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
+                 at_keyframe);
+  } else {
+    spdlog::info("global BA before saving the map: {} keyframes, {} points, {:.0f} ms",
+                 job->keyframes.size(), job->points.size(), job->ms);
+  }
   map_.NoteLoopCorrection();  // tracking follows its reference keyframe
 }
 
@@ -539,6 +582,17 @@ void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& even
   }
   graph.cam_from_world = start;
   graph.fixed.assign(vertices.size(), false);
+  // Edge information. Identity (ORB-SLAM) weighs a metre of translation like a radian of
+  // rotation, so a loop's translation gap is closed almost only by bending and rescaling the
+  // chain (cheap per edge, large at the end of a long lever): on the street ring a 0.58 m,
+  // 0.6 deg loop turned the middle of the lap by 1.1 deg and moved it by 1.4 m. A
+  // keyframe's relative pose is measured from image motion: a rotation error of e rad and a
+  // translation error of e * Z m (Z the scene depth) shift the image alike, so the translation
+  // residual is divided by the scene depth. Measured per edge against ground truth (street
+  // ring: Z ~26 m, translation / rotation error 38 m/rad; office: Z ~2 m, 2.0 m/rad).
+  const bool depth_weighted = options_.edge_information == "depth";
+  std::vector<double> scene_depth;
+  if (depth_weighted) scene_depth = SceneDepths(vertices);
   graph.fixed[vertex_of.at(loop.match->id)] = true;
   std::set<std::pair<size_t, size_t>> added;
   auto add_edge = [&](size_t i, size_t j, bool loop_edge) {
@@ -546,7 +600,14 @@ void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& even
     const auto key = std::make_pair(std::min(i, j), std::max(i, j));
     if (!added.insert(key).second) return;
     const std::vector<Sim3d>& poses = loop_edge ? start : measure_pose;
-    graph.edges.push_back({i, j, poses[i] * poses[j].Inverse()});
+    PoseGraphEdge edge{i, j, poses[i] * poses[j].Inverse()};
+    if (depth_weighted) {
+      // Translation in units of the two keyframes' scene depth, like the rotation in radians:
+      // both are then the image displacement they cause (see where depth_weighted is set).
+      const double z = 0.5 * (scene_depth[i] + scene_depth[j]);
+      edge.sqrt_information.segment<3>(3).setConstant(1.0 / z);
+    }
+    graph.edges.push_back(edge);
   };
   for (const auto& [a, b] : loop_edges_) {
     const auto ia = vertex_of.find(a), ib = vertex_of.find(b);

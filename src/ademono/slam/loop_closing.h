@@ -76,6 +76,9 @@ class LoopClosing {
   bool UsesSim3() const { return sim3_; }
   // End of the sequence: merges a pending global BA (waits for its solve).
   void FinishGlobalBundleAdjustment() ADEMONO_REQUIRES(map_.mutex);
+  // A global bundle adjustment of the whole map now, on this thread (`loop.global_ba_on_save`:
+  // before the map is written). Any pending one is merged first. Not a loop event.
+  void GlobalBundleAdjustmentNow() ADEMONO_REQUIRES(map_.mutex);
 
   // A verified loop: the candidate, match_cam_from_query_cam and the candidate's map points
   // matched to the query's keypoints (null where none).
@@ -106,11 +109,11 @@ class LoopClosing {
     std::optional<BundleAdjustmentResult> result;
     std::exception_ptr failure;
     double ms = 0;
-    size_t event = 0;          // index into events_
+    std::optional<size_t> event;  // index into events_; none for the one before a map is saved
     int keyframes_since = 0;   // keyframes processed since the gather
     std::thread worker;
   };
-  void StartGlobalBundleAdjustment(size_t event) ADEMONO_REQUIRES(map_.mutex);
+  void StartGlobalBundleAdjustment(std::optional<size_t> event) ADEMONO_REQUIRES(map_.mutex);
   // Joins the solve; applies it when `apply`, else drops it.
   void EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) ADEMONO_REQUIRES(map_.mutex);
 

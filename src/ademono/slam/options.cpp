@@ -140,10 +140,12 @@ const OptionsTable<LoopOptions>& LoopOptions::Table() {
           .Add("consistency", &L::consistency, Range::AtLeast(1))
           .Add("strong_edge_weight", &L::strong_edge_weight, Range::AtLeast(1))
           .Add("pose_graph_iterations", &L::pose_graph_iterations, Range::AtLeast(1))
+          .Add("edge_information", &L::edge_information)
           .Add("transform", &L::transform)
           .Add("global_ba", &L::global_ba)
           .Add("global_ba_iterations", &L::global_ba_iterations, Range::AtLeast(1))
-          .Add("global_ba_handoff_keyframes", &L::global_ba_handoff_keyframes, Range::AtLeast(1));
+          .Add("global_ba_handoff_keyframes", &L::global_ba_handoff_keyframes, Range::AtLeast(1))
+          .Add("global_ba_on_save", &L::global_ba_on_save);
   return table;
 }
 
@@ -151,6 +153,8 @@ void LoopOptions::Check() const {
   Table().CheckRanges(*this);
   Require(transform == "auto" || transform == "sim3" || transform == "se3",
           "loop: transform must be auto, sim3 or se3");
+  Require(edge_information == "depth" || edge_information == "identity",
+          "loop: edge_information must be depth or identity");
   Require(min_projection_matches >= min_inliers,
           "loop: need min_projection_matches >= min_inliers");
 }

@@ -174,6 +174,10 @@ struct LoopOptions {
   int consistency = 3;           // consecutive keyframes verified against the same place
   int strong_edge_weight = 100;  // covisibility edges kept in the essential graph
   int pose_graph_iterations = 20;
+  // Information of the essential graph's edges: "depth" divides each edge's translation residual
+  // by the scene depth of its keyframes (a translation error then weighs what it shifts in the
+  // image, like a rotation error in radians); "identity" weighs a metre like a radian (ORB-SLAM).
+  std::string edge_information = "depth";
   // "auto": Sim(3) when depth is a network's prior (its scale drifts), SE(3) with sensor depth;
   // "sim3" | "se3" force one.
   std::string transform = "auto";
@@ -182,6 +186,9 @@ struct LoopOptions {
   bool global_ba = false;
   int global_ba_iterations = 10;
   int global_ba_handoff_keyframes = 2;
+  // A global bundle adjustment of the whole map before `--save-map` writes it (the run's
+  // trajectory follows it): the map a later session inherits (docs/maps.md).
+  bool global_ba_on_save = false;
   bool UseSim3(bool depth_is_prior) const {
     return transform == "sim3" || (transform == "auto" && depth_is_prior);
   }
