@@ -697,11 +697,20 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
 
+  // ORB-SLAM's close-point rule: a keyframe when few close keypoints are tracked and many could
+  // become new close points. With network depth (a prior), a close keypoint whose map point was
+  // matched but rejected by the pose is not structure the map lacks: the point is there, moved
+  // by the prior's error (depth-edge smear, per-frame noise), and a keyframe would only re-create
+  // it from the same kind of depth, to be fused back into the old one. Counting those as
+  // untracked fired the rule on nearly every frame of an already mapped place (the soak's office:
+  // about 50 such keypoints a frame, docs/reliability.md section 6), and the map never saturated.
+  const bool depth_prior = frame.F().DepthIsPrior();
   int tracked_close = 0, untracked_close = 0;
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (!f.IsClose(i)) continue;
-    if (frame.map_points[i] && !frame.outlier[i]) {
+    const auto& point = frame.map_points[i];
+    if (point && (!frame.outlier[i] || (depth_prior && !point->bad && UsableForPose(*point)))) {
       ++tracked_close;
     } else {
       ++untracked_close;
@@ -723,7 +732,14 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
       local_points_.size(), local_keyframes_.size());
   if (!((c1a || c1b || c1c) && c2)) return false;
   // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
-  return idle || local_mapping_.QueueSize() < 3;
+  const bool insert = idle || local_mapping_.QueueSize() < 3;
+  if (insert) {
+    spdlog::debug("frame {}: keyframe ({}{}{}{}{}; inliers {}, ratio bar {:.0f} of {})",
+                  frame.index, c1a ? "max_interval " : "", c1b ? "idle " : "", weak ? "weak " : "",
+                  need_close ? "close " : "", matches_inliers_ < ref_matches * ratio ? "ratio" : "",
+                  matches_inliers_, ref_matches * ratio, ref_matches);
+  }
+  return insert;
 }
 
 std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
