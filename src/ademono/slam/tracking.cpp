@@ -698,26 +698,29 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const bool idle = local_mapping_.Idle();
 
   // ORB-SLAM's close-point rule: a keyframe when few close keypoints are tracked and many could
-  // become new close points. With network depth (a prior), a close keypoint whose map point was
-  // matched but rejected by the pose is not structure the map lacks: the point is there, moved
-  // by the prior's error (depth-edge smear, per-frame noise), and a keyframe would only re-create
-  // it from the same kind of depth, to be fused back into the old one. Counting those as
-  // untracked fired the rule on nearly every frame of an already mapped place (the soak's office:
-  // about 50 such keypoints a frame, docs/reliability.md section 6), and the map never saturated.
-  const bool depth_prior = frame.F().DepthIsPrior();
-  int tracked_close = 0, untracked_close = 0;
+  // become new close points, unless the place is already mapped (tracking.mapped_place_ratio):
+  // most tracked close points are each seen by `redundant_observers` keyframes, keyframe
+  // culling's test (LocalMapping::CullKeyFrames, without its scale-level condition). There the
+  // untracked close keypoints are not structure the map lacks (with network depth: points the
+  // prior misplaced, a mover, keypoints that do not repeat): a keyframe would re-make them from
+  // the same kind of depth. Without it the rule fired on nearly every frame of a revisited
+  // place, faster than culling removed keyframes (docs/reliability.md section 6).
+  int tracked_close = 0, untracked_close = 0, established_close = 0;
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (!f.IsClose(i)) continue;
     const auto& point = frame.map_points[i];
-    if (point && (!frame.outlier[i] || (depth_prior && !point->bad && UsableForPose(*point)))) {
+    if (point && !frame.outlier[i]) {
       ++tracked_close;
+      if (point->NumObservations() >= options_.mapping.redundant_observers) ++established_close;
     } else {
       ++untracked_close;
     }
   }
-  const bool need_close =
-      tracked_close < t.close_tracked_min && untracked_close > t.close_untracked_min;
+  const bool mapped_place = t.mapped_place_ratio > 0 && tracked_close > 0 &&
+                            established_close > t.mapped_place_ratio * tracked_close;
+  const bool need_close = tracked_close < t.close_tracked_min &&
+                          untracked_close > t.close_untracked_min && !mapped_place;
   const double ratio = map_.NumKeyFrames() < 2 ? 0.4 : t.keyframe_ref_ratio;
   const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
   const bool c1a = since_kf >= static_cast<uint64_t>(t.max_frames_between_keyframes);
@@ -727,8 +730,9 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const bool c1c = weak || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
   spdlog::debug(
-      "frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
-      frame.index, matches_inliers_, ref_matches, tracked_close, untracked_close,
+      "frame {}: inliers {} ref_matches {} close tracked {} ({} established) untracked {} local "
+      "points {} kfs {}",
+      frame.index, matches_inliers_, ref_matches, tracked_close, established_close, untracked_close,
       local_points_.size(), local_keyframes_.size());
   if (!((c1a || c1b || c1c) && c2)) return false;
   // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
