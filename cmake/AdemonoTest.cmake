@@ -7,6 +7,9 @@ function(ademono_add_test name)
   cmake_parse_arguments(ARG "CLI" "" "SOURCES;LIBS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
+  if(ADEMONO_TEST_OPT)
+    target_compile_options(${name} PRIVATE ${ADEMONO_TEST_OPT})
+  endif()
   get_filename_component(_shared "${PROJECT_SOURCE_DIR}/../shared" ABSOLUTE)
   target_compile_definitions(${name} PRIVATE
     ADEMONO_SHARED_DIR="${_shared}"

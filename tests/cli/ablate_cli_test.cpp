@@ -66,7 +66,8 @@ TEST_F(AblateCliTest, FiveVariantsAndTable) {
   EXPECT_EQ(md, r.out);
   for (const char* column :
        {"ATE se3 (m)", "ATE sim3 (m)", "tracked", "keyframes", "removed enh", "removed dyn",
-        "removed distant", "moving removed", "unboxed moving removed", "static removed",
+        "removed distant", "moving removed", "moving kept out of tracking and map",
+        "unboxed moving removed", "static removed",
         "static person removed"})
     EXPECT_THAT(md, HasSubstr(column));
   std::ifstream in(out / "ablation.json");

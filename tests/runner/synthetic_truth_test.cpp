@@ -100,6 +100,45 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   EXPECT_EQ(edge.static_at_mover_edge_removed, 1);
   EXPECT_EQ(edge.static_removed_stage1, 1);
 
+  // Whether a keypoint entered tracking or the map: a moving pose inlier entered; a new
+  // keyframe point made from a keypoint entered only if it was ever admitted, also through the
+  // point that replaced it (fusion). Static: a new point judged moving before it was admitted is
+  // kept out (removed); one never admitted without such a verdict is only unconfirmed.
+  auto point = [](bool admitted, int motion_verdicts) {
+    auto p = std::make_shared<MapPoint>(0, Eigen::Vector3d::Zero(), nullptr, 0);
+    p->admitted = admitted;
+    p->motion_verdicts = motion_verdicts;
+    return p;
+  };
+  const auto replaced = point(false, 0);
+  replaced->replaced_by = point(true, 0);
+  // Keypoint 1 (moving, kept): a pose inlier. Keypoint 0 (moving, labelled) made a new point
+  // that was admitted all the same (it entered the map). Static 5 (unconfirmed) made one judged
+  // moving (already removed: counted once), static 8 one never judged, static 7 one replaced by
+  // an admitted point, static 3 one judged moving.
+  const std::vector<MatchState> fate{M::kUnmatched,  M::kPoseInlier, M::kUnmatched,
+                                     M::kPoseInlier, M::kUnmatched,  M::kUnconfirmed,
+                                     M::kUnmatched,  M::kUnmatched,  M::kUnmatched};
+  const std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>> created{
+      {0, point(true, 0)}, {5, point(false, 2)}, {8, point(false, 0)}, {7, replaced},
+      {3, point(false, 1)}};
+  TruthCounts entered;
+  std::vector<PendingPoint> pending;
+  truth.Score(frame, {}, kps, labels, &entered, &fate, &created, &pending);
+  EXPECT_EQ(pending.size(), 5u);
+  EXPECT_EQ(entered.moving_pose_inliers, 1);
+  EXPECT_EQ(entered.moving_new_points, 1);
+  EXPECT_EQ(entered.static_new_points, 4);
+  const long long removed_before = entered.static_kept_out;
+  EXPECT_EQ(removed_before, entered.static_removed);
+  SyntheticTruth::Resolve(pending, &entered);
+  EXPECT_EQ(entered.moving_new_points_admitted, 1);
+  EXPECT_EQ(entered.MovingEntered(), 2);  // both moving keypoints entered
+  EXPECT_EQ(entered.static_new_points_judged_out, 2);
+  EXPECT_EQ(entered.static_new_points_unconfirmed, 1);
+  EXPECT_EQ(entered.static_kept_out, removed_before + 1);  // keypoint 3; 5 was already removed
+  EXPECT_EQ(entered.ToJson()["moving_kept_out"], 0);
+
   frame.name = "missing";
   EXPECT_THROW(truth.Score(frame, {}, kps, labels, &counts), InputError);
   EXPECT_FALSE(SyntheticTruth(dir / "nothing").Available());

@@ -55,11 +55,13 @@ class SyntheticOffice : public Sequence {
   // Ground-truth boxes of the dynamic-class objects visible in frame i (what the detector cache
   // of `ademono synth` holds).
   std::vector<Detection> Detections(size_t i) const { return Render(i).detections; }
+  // 255 where a moving object is the visible surface of frame i (synth's masks/), else 0.
+  cv::Mat MovingMask(size_t i) const { return Render(i).moving.clone(); }
   Rigid3d WorldFromCam(size_t i) const { return scene_.world_from_cam(Timestamp(i)); }
 
  private:
   struct Rendered {
-    cv::Mat image, depth;
+    cv::Mat image, depth, moving;
     std::vector<Detection> detections;
   };
   const Rendered& Render(size_t i) const {
@@ -67,7 +69,7 @@ class SyntheticOffice : public Sequence {
     std::optional<Rendered>& slot = frames_.at(i);
     if (!slot) {
       const synth::RenderedFrame f = synth::RenderSceneFrame(scene_, i, options_);
-      slot = Rendered{f.image, f.depth,
+      slot = Rendered{f.image, f.depth, synth::MovingMask(scene_, f.object_id),
                       synth::BoxesFromObjectIds(scene_, f.object_id, options_.min_box_pixels)};
     }
     return *slot;

@@ -143,6 +143,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   const SyntheticTruth truth(sequence.Path());
   const bool score = options.score_synthetic_truth && truth.Available();
   if (score) report.truth = TruthCounts{};
+  std::vector<PendingPoint> pending_points;  // new map points whose fate the run's end decides
   PipelineOptions pipeline = options.pipeline;
   pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&,
                           const std::vector<Detection>& detections, const TrackResult& r) {
@@ -165,7 +166,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     report.per_frame.push_back(f);
     report.filter_totals.Add(r.filter_stats, r.num_keypoints);
     if (score)
-      truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.match_state);
+      truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.match_state,
+                  &r.created_points, &pending_points);
     if (options.on_frame) options.on_frame(frame, detections, r);
   };
   std::unique_ptr<RealtimeFeed> feed;
@@ -175,6 +177,10 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   }
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
   system.Shutdown();
+  if (score) {
+    SyntheticTruth::Resolve(pending_points, &*report.truth);
+    pending_points.clear();
+  }
   if (!options.save_map.empty()) system.SaveMap(options.save_map);
   if (feed) {
     report.realtime = options.realtime;

@@ -53,7 +53,18 @@ nlohmann::json TruthCounts::ToJson() const {
           {"moving_not_removed_unboxed", moving_not_removed_unboxed},
           {"static_at_mover_edge_keypoints", static_at_mover_edge_keypoints},
           {"static_at_mover_edge_removed", static_at_mover_edge_removed},
-          {"moving_removed_geometric", moving_removed_geometric}};
+          {"moving_removed_geometric", moving_removed_geometric},
+          {"moving_pose_inliers", moving_pose_inliers},
+          {"moving_new_points", moving_new_points},
+          {"moving_new_points_admitted", moving_new_points_admitted},
+          {"moving_entered", MovingEntered()},
+          {"moving_kept_out", moving_keypoints - MovingEntered()},
+          {"moving_kept_out_ratio", ratio(moving_keypoints - MovingEntered(), moving_keypoints)},
+          {"static_new_points", static_new_points},
+          {"static_new_points_judged_out", static_new_points_judged_out},
+          {"static_new_points_unconfirmed", static_new_points_unconfirmed},
+          {"static_kept_out", static_kept_out},
+          {"static_kept_out_ratio", ratio(static_kept_out, static_keypoints)}};
 }
 
 SyntheticTruth::SyntheticTruth(const fs::path& sequence_dir) : masks_dir_(sequence_dir / "masks") {
@@ -72,7 +83,10 @@ cv::Point Pixel(const cv::KeyPoint& kp, const cv::Size& size) {
 void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>& detections,
                            const std::vector<cv::KeyPoint>& keypoints,
                            const std::vector<PointLabel>& labels, TruthCounts* counts,
-                           const std::vector<MatchState>* match_state) const {
+                           const std::vector<MatchState>* match_state,
+                           const std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>*
+                               created,
+                           std::vector<PendingPoint>* pending) const {
   const fs::path path = masks_dir_ / (frame.name + ".png");
   RequireFile(path);
   const cv::Mat mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
@@ -97,6 +111,12 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5));
   cv::dilate(mask > 127, near_mover, kernel);
   cv::dilate(mask <= 127, near_static, kernel);
+  std::vector<const std::shared_ptr<const MapPoint>*> created_by(keypoints.size(), nullptr);
+  if (created != nullptr) {
+    for (const auto& [i, point] : *created) {
+      if (i < created_by.size()) created_by[i] = &point;
+    }
+  }
   for (size_t i = 0; i < keypoints.size() && i < labels.size(); ++i) {
     const cv::Point p = Pixel(keypoints[i], mask.size());
     // Only keypoints the dynamic filter judged: enhancement drops happen before it.
@@ -113,7 +133,17 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
              d.box.contains(cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)));
     });
     const bool geometric_only = dynamic && !IsDynamic(labels[i]);
-    if (mask.at<uint8_t>(p) > 127) {
+    const bool moving = mask.at<uint8_t>(p) > 127;
+    if (moving) {
+      if (state == MatchState::kPoseInlier) ++counts->moving_pose_inliers;
+    } else {
+      if (dynamic) ++counts->static_kept_out;
+    }
+    if (created_by[i] != nullptr && pending != nullptr) {
+      (moving ? counts->moving_new_points : counts->static_new_points) += 1;
+      pending->push_back({moving, dynamic, *created_by[i]});
+    }
+    if (moving) {
       ++counts->moving_keypoints;
       if (dynamic) ++counts->moving_removed;
       if (geometric_only) ++counts->moving_removed_geometric;
@@ -154,6 +184,25 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
       if (in_box) {
         ++counts->static_in_box_keypoints;
         if (dynamic) ++counts->static_in_box_removed;
+      }
+    }
+  }
+}
+
+void SyntheticTruth::Resolve(const std::vector<PendingPoint>& pending, TruthCounts* counts) {
+  for (const PendingPoint& p : pending) {
+    bool admitted = false;
+    // Fusion may have replaced the point; its keypoint's view went to the replacement.
+    for (const MapPoint* q = p.point.get(); q != nullptr && !admitted; q = q->replaced_by.get())
+      admitted = q->admitted;
+    if (p.moving) {
+      if (admitted) ++counts->moving_new_points_admitted;
+    } else if (!admitted) {
+      if (p.point->motion_verdicts > 0) {
+        ++counts->static_new_points_judged_out;
+        if (!p.already_removed) ++counts->static_kept_out;
+      } else {
+        ++counts->static_new_points_unconfirmed;
       }
     }
   }

@@ -6,12 +6,14 @@
 
 #include <array>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <vector>
 
 #include "ademono/filter/feature_filter.h"
 #include "ademono/io/sequence.h"
 #include "ademono/perception/detection.h"
+#include "ademono/slam/map_point.h"
 #include "ademono/slam/tracking.h"
 
 namespace ademono {
@@ -61,7 +63,31 @@ struct TruthCounts {
   long long static_at_mover_edge_keypoints = 0;
   long long static_at_mover_edge_removed = 0;
   long long moving_removed_geometric = 0;  // moving keypoints only the geometric test removed
+  // Whether a keypoint fed tracking or the map: a pose inlier, or the source of a new keyframe
+  // point that was ever admitted into the pose and BA (MapPoint::admitted, known at the end of
+  // the run). Every other moving keypoint is kept out: removed by a label or the geometric
+  // test, rejected by the pose, unmatched, or its new point never confirmed by another view.
+  long long moving_pose_inliers = 0;
+  long long moving_new_points = 0;           // moving keypoints a new keyframe made points of
+  long long moving_new_points_admitted = 0;  // ... whose point was admitted (entered the map)
+  // Static keypoints a new keyframe made points of; those never admitted because the geometric
+  // test judged them moving (kept out of the map: removed), and those never admitted without
+  // such a verdict (never seen again, culled by local mapping, or no decisive view).
+  long long static_new_points = 0;
+  long long static_new_points_judged_out = 0;
+  long long static_new_points_unconfirmed = 0;
+  // Static keypoints removed (static_removed) plus those whose new point was judged out.
+  long long static_kept_out = 0;
+  // Moving keypoints that entered tracking or the map: pose inliers and admitted new points.
+  long long MovingEntered() const { return moving_pose_inliers + moving_new_points_admitted; }
   nlohmann::json ToJson() const;
+};
+
+// A keypoint whose new map point's fate is known only at the end of the run.
+struct PendingPoint {
+  bool moving = false;
+  bool already_removed = false;  // labelled dynamic or kept out by the geometric test
+  std::shared_ptr<const MapPoint> point;
 };
 
 // Reads masks/<frame name>.png of a synthetic sequence and finds the static person box of a
@@ -74,9 +100,17 @@ class SyntheticTruth {
   // Throws InputError when the frame's mask is missing or not the image size.
   // `match_state` (optional, per keypoint): what tracking made of each keypoint; an unconfirmed
   // or judged-moving one counts as removed like a dynamic label.
+  // `created` (optional): the map points a new keyframe made from the frame's keypoints (index
+  // into `keypoints`); they go to `pending`, to be counted by Resolve after the run.
   void Score(const FrameData& frame, const std::vector<Detection>& detections,
              const std::vector<cv::KeyPoint>& keypoints, const std::vector<PointLabel>& labels,
-             TruthCounts* counts, const std::vector<MatchState>* match_state = nullptr) const;
+             TruthCounts* counts, const std::vector<MatchState>* match_state = nullptr,
+             const std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>* created =
+                 nullptr,
+             std::vector<PendingPoint>* pending = nullptr) const;
+  // After the run (the map no longer changes): which pending new points were ever admitted,
+  // following fusion (a point replaced by an admitted one entered the map through it).
+  static void Resolve(const std::vector<PendingPoint>& pending, TruthCounts* counts);
 
  private:
   std::filesystem::path masks_dir_;

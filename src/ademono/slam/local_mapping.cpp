@@ -354,6 +354,9 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     for (KeyFrame* kf : local) {
       for (const auto& p : kf->map_points) {
         if (!p || p->bad || p->ba_local_for == keyframe.id) continue;
+        // A new point awaiting its confirming view (the geometric test) stays out, as it stays
+        // out of the pose: a mover seen in one keyframe never shapes the keyframes.
+        if (!p->admitted) continue;
         p->ba_local_for = keyframe.id;
         local_points.push_back(p.get());
       }

@@ -36,6 +36,12 @@ class MapPoint {
   int dynamic_hits = 0;
   // P(static) of the geometric test (slam/static_probability.h); 1 when the test is off.
   double static_probability = 1.0;
+  // Whether the point was ever let into the pose and local BA (P(static) at or above the
+  // geometric test's threshold). A new keyframe's point starts below it and is admitted only
+  // when another view confirms it; until then local BA leaves it out, as the pose does. A mover's
+  // point is never admitted (synthetic truth scores this).
+  bool admitted = true;
+  int motion_verdicts = 0;  // the geometric test's verdicts of motion (synthetic truth scores it)
   bool bad = false;
   // Part of a map loaded for localisation only: position, descriptor, normal, statistics and its
   // observations by loaded keyframes never change (temporary keyframes may observe it).

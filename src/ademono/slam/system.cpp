@@ -73,6 +73,15 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
       ++k;
     }
   }
+  if (!out.created_points.empty()) {
+    std::vector<size_t> extracted_index;  // feature index -> extracted keypoint index
+    for (size_t i = 0; i < extracted.keypoints.size(); ++i) {
+      if (filtered.labels[i] == PointLabel::kKept) extracted_index.push_back(i);
+    }
+    for (const auto& [k, point] : out.created_points) {
+      if (k < extracted_index.size()) result.created_points.emplace_back(extracted_index[k], point);
+    }
+  }
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
   result.new_keyframe = back.new_keyframe;

@@ -44,6 +44,9 @@ struct TrackResult {
   // ... and per keypoint what tracking made of it (kUnmatched for keypoints the filter removed;
   // empty when the frame is untracked).
   std::vector<MatchState> match_state;
+  // ... and the map points a new keyframe made from them (index into `keypoints`; see
+  // TrackingOutput::created_points).
+  std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>> created_points;
   // Wall milliseconds per stage. extraction (grey + ORB) and keypoint_depth come from wherever
   // the frame was extracted (the pipeline's prefetch thread, or TrackFrame itself).
   double extraction_ms = 0, keypoint_depth_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;

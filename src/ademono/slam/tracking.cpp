@@ -224,7 +224,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
         AnchorScale(frame);
-        out.new_keyframe = CreateNewKeyFrame(frame);
+        out.new_keyframe = CreateNewKeyFrame(frame, &out.created_points);
       }
       // Outliers do not carry over to the next frame's motion-model search.
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
@@ -290,6 +290,7 @@ void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
   auto point = map_.CreateMapPoint(world_from_cam * frame.F().UnprojectCamera(i), &keyframe,
                                    frame.id);
   if (options_.tracking.static_test) point->static_probability = static_probability;
+  point->admitted = UsableForPose(*point);
   point->AddObservation(&keyframe, i);
   keyframe.AddMapPoint(point, i);
   point->ComputeDistinctiveDescriptor();
@@ -664,9 +665,13 @@ int Tracking::JudgeStaticness(Frame& frame) {
         if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
       }
     }
-    p->static_probability = UpdateStaticProbability(
-        p->static_probability, JudgeObservation(residual, depth_error, params, depth_sigma));
-    if (UsableForPose(*p)) continue;
+    const StaticEvidence evidence = JudgeObservation(residual, depth_error, params, depth_sigma);
+    if (evidence == StaticEvidence::kDynamic) ++p->motion_verdicts;
+    p->static_probability = UpdateStaticProbability(p->static_probability, evidence);
+    if (UsableForPose(*p)) {
+      p->admitted = true;
+      continue;
+    }
     ++dynamic;
     frame.outlier[i] = true;
     // Never a loaded map's point (localisation only), nor an odometry point (not in the map).
@@ -746,7 +751,8 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   return insert;
 }
 
-std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
+std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
+    Frame& frame, std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>* created) {
   std::shared_ptr<KeyFrame> kf = map_.CreateKeyFrame(frame);
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     if (frame.map_points[i] && !frame.outlier[i] && !frame.map_points[i]->bad) {
@@ -770,6 +776,7 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(Frame& frame) {
                            boxed ? options_.tracking.static_params.box_prior
                                  : options_.tracking.static_params.prior);
       frame.outlier[i] = false;
+      if (created != nullptr) created->emplace_back(i, frame.map_points[i]);
     }
     ++considered;
     if (z > f.close_depth && considered > options_.tracking.new_keyframe_min_points) break;

@@ -72,6 +72,10 @@ struct TrackingOutput {
   // Per keypoint of the frame's features (tracked frames; else empty): what the tracking made of
   // it, taken before a new keyframe adds this frame's own points (those were not matched).
   std::vector<MatchState> match_state;
+  // The map points a new keyframe made from this frame's unmatched keypoints (index into the
+  // features, point): whether they are ever admitted (MapPoint::admitted) tells, at the end of
+  // a run, whether those keypoints entered the map. Empty unless the frame became a keyframe.
+  std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>> created_points;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
 };
 
@@ -115,7 +119,10 @@ class Tracking {
   bool TrackLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool Relocalise(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool NeedNewKeyFrame(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
-  std::shared_ptr<KeyFrame> CreateNewKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // `created`: the points made from the frame's own depth (TrackingOutput::created_points).
+  std::shared_ptr<KeyFrame> CreateNewKeyFrame(
+      Frame& frame, std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>* created)
+      ADEMONO_REQUIRES(map_.mutex);
   // Motion-only pose optimisation on the matched points with static probability >= min_static
   // (< 0: the geometric test's threshold); `map_points_only`: without localisation-only mode's
   // odometry points.
