@@ -14,6 +14,7 @@
 // `--depth model:`).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
+#include <spdlog/spdlog.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -37,6 +38,14 @@ using namespace ademono;
 
 enum Variant { kPlain = 0, kDetections = 1, kNetworkDepth = 2 };
 const char* const kVariantNames[] = {"plain", "detections", "network_depth"};
+
+// Report window (frames), ADEMONO_SOAK_WINDOW; 1000 by default. Shorter windows show how the map
+// grows early on (the 1k/5k/10k counters are taken whatever the window).
+size_t SoakWindow() {
+  const char* env = std::getenv("ADEMONO_SOAK_WINDOW");
+  const size_t w = env != nullptr ? std::strtoul(env, nullptr, 10) : 1000;
+  return w > 0 ? w : 1000;
+}
 
 size_t SoakFrames() {
   const char* env = std::getenv("ADEMONO_SOAK_FRAMES");
@@ -70,13 +79,38 @@ double CurrentRssMb() {
   return resident * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
+// ADEMONO_SOAK_SET="section.key=value;section.key=value": overrides on top of the variant's
+// configuration (as `ademono run --set`), to compare settings on the soak.
 SystemOptions Options(Variant variant) {
   SystemOptions options;
+  YAML::Node config(YAML::NodeType::Map);
+  std::string path = "ADEMONO_SOAK_SET";
   if (variant == kNetworkDepth) {
     // What `ademono run --depth model:...` picks indoors: depth as a prior with scale correction.
-    const std::string path = std::string(ADEMONO_SOURCE_DIR) + "/configs/network_indoor.yaml";
-    options = SystemOptions::FromYaml(YAML::LoadFile(path), path);
+    path = std::string(ADEMONO_SOURCE_DIR) + "/configs/network_indoor.yaml";
+    config = YAML::LoadFile(path);
   }
+  bool overridden = false;
+  if (const char* env = std::getenv("ADEMONO_SOAK_SET")) {
+    std::string items = env;
+    size_t start = 0;
+    while (start < items.size()) {
+      size_t end = items.find(';', start);
+      if (end == std::string::npos) end = items.size();
+      const std::string item = items.substr(start, end - start);
+      start = end + 1;
+      const size_t dot = item.find('.'), eq = item.find('=');
+      if (dot == std::string::npos || eq == std::string::npos || eq < dot) {
+        std::fprintf(stderr, "ADEMONO_SOAK_SET: '%s' is not section.key=value\n", item.c_str());
+        std::exit(2);
+      }
+      config[item.substr(0, dot)][item.substr(dot + 1, eq - dot - 1)] =
+          YAML::Load(item.substr(eq + 1));
+      std::fprintf(stderr, "set %s\n", item.c_str());
+      overridden = true;
+    }
+  }
+  if (variant == kNetworkDepth || overridden) options = SystemOptions::FromYaml(config, path);
   options.orb.num_features = 1000;
   options.filter.enable_dynamic_removal = variant == kDetections;
   return options;
@@ -92,7 +126,11 @@ size_t SourceFrame(size_t k, size_t period) {
 
 void BM_Soak(benchmark::State& state) {
   const auto variant = static_cast<Variant>(state.range(0));
+  // ADEMONO_SOAK_LOG=debug: the library's debug log (keyframe decisions, local mapping) on stderr.
+  if (const char* level = std::getenv("ADEMONO_SOAK_LOG"))
+    spdlog::set_level(spdlog::level::from_str(level));
   const size_t frames = SoakFrames();
+  const size_t report_window = SoakWindow();
   const size_t period = 300;  // 10 s of the office path at 30 fps
   synth::SceneOptions scene_options;
   scene_options.scene = "office";
@@ -140,8 +178,8 @@ void BM_Soak(benchmark::State& state) {
       tracking_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       lost_in_window += r.tracked ? 0 : 1;
-      if ((k + 1) % 1000 == 0 || k + 1 == frames) {
-        const size_t window = (k % 1000) + 1;
+      if ((k + 1) % report_window == 0 || k + 1 == frames) {
+        const size_t window = (k % report_window) + 1;
         const double peak = PeakRssMb();
         const double heap = HeapInUseMb();
         const double window_cpu = ProcessCpuSeconds() - window_cpu_start;
@@ -155,10 +193,10 @@ void BM_Soak(benchmark::State& state) {
         if (done == 1000) state.counters["peak_rss_1k_mb"] = peak;
         if (done == 5000) state.counters["peak_rss_5k_mb"] = peak;
         if (done == 10000) state.counters["peak_rss_10k_mb"] = peak;
-        if (done == 1000) state.counters["fps_first_1k"] = window / tracking_seconds;
-        state.counters["fps_last_1k"] = window / tracking_seconds;
-        if (done == 1000) state.counters["cpu_fps_first_1k"] = window / window_cpu;
-        state.counters["cpu_fps_last_1k"] = window / window_cpu;
+        if (done == report_window) state.counters["fps_first_window"] = window / tracking_seconds;
+        state.counters["fps_last_window"] = window / tracking_seconds;
+        if (done == report_window) state.counters["cpu_fps_first_window"] = window / window_cpu;
+        state.counters["cpu_fps_last_window"] = window / window_cpu;
         tracking_seconds = 0;
         window_cpu_start = ProcessCpuSeconds();
         lost_in_window = 0;

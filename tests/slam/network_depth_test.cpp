@@ -3,9 +3,11 @@
 // 7-Scenes: log-scale spread 0.16). The per-frame scale correction must undo each frame's scale
 // exactly enough, and the map's scale must settle at the network's long-run average.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "ademono/depth/simulated_depth.h"
@@ -118,6 +120,56 @@ TEST(NetworkDepthTest, ScaleCorrectionRecoversEachFramesScaleAndAnchorsTheMap) {
   eval.alignment = Alignment::kSim3;
   const EvalResult result = EvaluateTrajectories(run.truth, run.estimate, eval);
   EXPECT_LT(result.ape.rmse, 0.05);
+}
+
+// tracking.mapped_place_ratio (configs/network_indoor.yaml): on a place mapped already, the
+// close-point rule must not make a keyframe on nearly every frame. The camera goes back and
+// forth over the first 40 frames of the office path (as the soak benchmark does over 300,
+// bench/soak_bench.cpp); in the fourth pass (a revisit) the unchecked rule (ratio 0) made a
+// keyframe on 37 of its 39 frames, the shipped 0.8 on 1.
+TEST(NetworkDepthTest, RevisitedPlaceMakesFewKeyframes) {
+  const std::string path = std::string(ADEMONO_SOURCE_DIR) + "/configs/network_indoor.yaml";
+  SystemOptions options = SystemOptions::FromYaml(YAML::LoadFile(path), path);
+  ASSERT_GT(options.tracking.mapped_place_ratio, 0.0);
+  options.orb.num_features = 1000;
+  options.filter.enable_dynamic_removal = false;
+  options.mapping.threaded = false;  // the count must not depend on the thread schedule
+
+  const size_t period = 40, frames = 2 * (2 * period - 2);
+  synth::SceneOptions scene_options;
+  scene_options.scene = "office";
+  scene_options.frames = period;
+  scene_options.seed = 5;
+  scene_options.persons = 1;
+  scene_options.width = 320;
+  scene_options.height = 240;
+  const synth::Scene scene = synth::BuildScene(scene_options);
+  synth::GeneratorOptions generator;
+  generator.scene = scene_options;
+  SimulatedDepthOptions depth_options;
+  depth_options.scale = 0.88;
+  depth_options.jitter = 0.16;
+  depth_options.jitter_frames = 60;
+  depth_options.seed = 3;
+  const SimulatedDepthProvider network(depth_options, nullptr);
+
+  System system(scene.camera, options);
+  int tracked = 0, keyframes_last_pass = 0;
+  for (size_t k = 0; k < frames; ++k) {
+    const size_t cycle = 2 * period - 2, m = k % cycle;
+    const size_t source = m < period ? m : cycle - m;
+    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, source, generator);
+    FrameData frame;
+    frame.index = k;
+    frame.timestamp = k / scene.fps;
+    frame.image = rendered.image;
+    const TrackResult r = system.TrackFrame(frame, network.Degrade(rendered.depth, k), {});
+    tracked += r.tracked ? 1 : 0;
+    if (k >= frames - cycle / 2 && r.new_keyframe) ++keyframes_last_pass;
+  }
+  system.Shutdown();
+  EXPECT_EQ(tracked, static_cast<int>(frames));
+  EXPECT_LE(keyframes_last_pass, 8);
 }
 
 }  // namespace

@@ -67,6 +67,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
                Range::AtLeast(0))
           .Add("close_tracked_min", &T::close_tracked_min, Range::AtLeast(0))
           .Add("close_untracked_min", &T::close_untracked_min, Range::AtLeast(0))
+          .Add("mapped_place_ratio", &T::mapped_place_ratio, Range::Closed(0, 1))
           .Add("new_keyframe_min_points", &T::new_keyframe_min_points, Range::AtLeast(0))
           .Add("relocalisation_keyframes", &T::relocalisation_keyframes, Range::Above(0))
           .Add("reinit_after_lost_frames", &T::reinit_after_lost_frames, Range::AtLeast(0))

@@ -90,6 +90,10 @@ struct TrackingOptions {
   int keyframe_ref_min_observations = 0;
   int close_tracked_min = 100;        // fewer tracked close points than this ...
   int close_untracked_min = 70;       // ... and more untracked ones: new keyframe
+  // The close-point rule does not fire on an already mapped place: when more than this share of
+  // the tracked close points are each seen by at least mapping.redundant_observers keyframes
+  // (keyframe culling's test), a keyframe there would be redundant. 0: off (ORB-SLAM).
+  double mapped_place_ratio = 0.0;
   int new_keyframe_min_points = 100;  // map points created from a new keyframe's depth at least
   int relocalisation_keyframes = 20;  // most recent keyframes tried when lost
   int reinit_after_lost_frames = 10;  // lost this long: restart tracking from the last pose

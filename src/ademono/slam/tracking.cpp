@@ -702,18 +702,30 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
 
-  int tracked_close = 0, untracked_close = 0;
+  // ORB-SLAM's close-point rule: a keyframe when few close keypoints are tracked and many could
+  // become new close points, unless the place is already mapped (tracking.mapped_place_ratio):
+  // most tracked close points are each seen by `redundant_observers` keyframes, keyframe
+  // culling's test (LocalMapping::CullKeyFrames, without its scale-level condition). There the
+  // untracked close keypoints are not structure the map lacks (with network depth: points the
+  // prior misplaced, a mover, keypoints that do not repeat): a keyframe would re-make them from
+  // the same kind of depth. Without it the rule fired on nearly every frame of a revisited
+  // place, faster than culling removed keyframes (docs/reliability.md section 6).
+  int tracked_close = 0, untracked_close = 0, established_close = 0;
   const FrameFeatures& f = frame.F();
   for (size_t i = 0; i < f.Size(); ++i) {
     if (!f.IsClose(i)) continue;
-    if (frame.map_points[i] && !frame.outlier[i]) {
+    const auto& point = frame.map_points[i];
+    if (point && !frame.outlier[i]) {
       ++tracked_close;
+      if (point->NumObservations() >= options_.mapping.redundant_observers) ++established_close;
     } else {
       ++untracked_close;
     }
   }
-  const bool need_close =
-      tracked_close < t.close_tracked_min && untracked_close > t.close_untracked_min;
+  const bool mapped_place = t.mapped_place_ratio > 0 && tracked_close > 0 &&
+                            established_close > t.mapped_place_ratio * tracked_close;
+  const bool need_close = tracked_close < t.close_tracked_min &&
+                          untracked_close > t.close_untracked_min && !mapped_place;
   const double ratio = map_.NumKeyFrames() < 2 ? 0.4 : t.keyframe_ref_ratio;
   const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
   const bool c1a = since_kf >= static_cast<uint64_t>(t.max_frames_between_keyframes);
@@ -723,12 +735,20 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const bool c1c = weak || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
   spdlog::debug(
-      "frame {}: inliers {} ref_matches {} close tracked {} untracked {} local points {} kfs {}",
-      frame.index, matches_inliers_, ref_matches, tracked_close, untracked_close,
+      "frame {}: inliers {} ref_matches {} close tracked {} ({} established) untracked {} local "
+      "points {} kfs {}",
+      frame.index, matches_inliers_, ref_matches, tracked_close, established_close, untracked_close,
       local_points_.size(), local_keyframes_.size());
   if (!((c1a || c1b || c1c) && c2)) return false;
   // Threaded mode: do not flood local mapping (ORB-SLAM's queue limit for RGB-D).
-  return idle || local_mapping_.QueueSize() < 3;
+  const bool insert = idle || local_mapping_.QueueSize() < 3;
+  if (insert) {
+    spdlog::debug("frame {}: keyframe ({}{}{}{}{}; inliers {}, ratio bar {:.0f} of {})",
+                  frame.index, c1a ? "max_interval " : "", c1b ? "idle " : "", weak ? "weak " : "",
+                  need_close ? "close " : "", matches_inliers_ < ref_matches * ratio ? "ratio" : "",
+                  matches_inliers_, ref_matches * ratio, ref_matches);
+  }
+  return insert;
 }
 
 std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
