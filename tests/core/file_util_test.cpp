@@ -1,5 +1,7 @@
 #include "ademono/core/file_util.h"
 
+#include <unistd.h>
+#include <string>
 #include <filesystem>
 #include <fstream>
 
@@ -34,7 +36,7 @@ TEST(FileUtil, SplitFields) {
 }
 
 TEST(FileUtil, AtomicWriteLeavesNothingOnFailure) {
-  const fs::path dir = fs::temp_directory_path() / "ademono_atomic_test";
+  const fs::path dir = fs::temp_directory_path() / ("ademono_atomic_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const fs::path target = dir / "out.txt";
   EXPECT_THROW(WriteFileAtomic(target,
@@ -50,7 +52,7 @@ TEST(FileUtil, AtomicWriteLeavesNothingOnFailure) {
 }
 
 TEST(FileUtil, ReadImageNamesTheFile) {
-  const fs::path dir = fs::temp_directory_path() / "ademono_image_test";
+  const fs::path dir = fs::temp_directory_path() / ("ademono_image_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path bad = dir / "broken.png";
   std::ofstream(bad) << "not a png";

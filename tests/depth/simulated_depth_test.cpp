@@ -1,5 +1,7 @@
 #include "ademono/depth/simulated_depth.h"
 
+#include <unistd.h>
+#include <string>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -171,7 +173,7 @@ TEST(SimulatedDepth, FactorySpecAndErrors) {
 }
 
 TEST(SimulatedDepth, GroundTruthFromCacheFolder) {
-  const fs::path dir = fs::temp_directory_path() / "ademono_simulated_gt";
+  const fs::path dir = fs::temp_directory_path() / ("ademono_simulated_gt_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   cv::imwrite((dir / "0.100000.tiff").string(), Constant(40.0));

@@ -1,5 +1,6 @@
 // Every dataset-family config in configs/ parses with the options' own checks, and its resolved
 // options (ToYaml) read back to exactly the same values.
+#include <unistd.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -78,7 +79,7 @@ TEST(ConfigsTest, ResolvedOptionsRoundTripForEveryShippedConfig) {
 }
 
 TEST(ConfigsTest, WriteResolvedConfigWritesTheFileAtomically) {
-  const fs::path dir = fs::temp_directory_path() / "ademono_resolved_config_test";
+  const fs::path dir = fs::temp_directory_path() / ("ademono_resolved_config_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const fs::path path = dir / "config.resolved.yaml";
   DetectorOptions detector;

@@ -1,6 +1,8 @@
 // Photo-textured actors: sprite quads in the renderer, cut-outs from a photo folder, and the
 // office with photo persons and movers of no COCO class. The photos are drawn here (a magenta
 // figure and a blue car on green), so the test needs no ../shared and knows every colour.
+#include <unistd.h>
+#include <string>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -26,7 +28,7 @@ bool Magenta(const cv::Vec3b& c) { return c[0] > 200 && c[1] < 60 && c[2] > 200;
 // A photo folder: one picture with a magenta person (ellipse body, round head) and a blue car on
 // a green background, and its expected_detections.json.
 fs::path MakePhotoFolder(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_photos_" + name);
+  const fs::path dir = fs::temp_directory_path() / ("ademono_photos_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   cv::Mat image(400, 500, CV_8UC3, cv::Scalar(0, 160, 0));
@@ -138,7 +140,7 @@ TEST(PhotoActors, CutOutsFollowTheFigureAndBadFoldersFail) {
 
 TEST(PhotoActors, OfficeWithPhotosIsDeterministicAndMasksMatchPixels) {
   const fs::path photos = MakePhotoFolder("office");
-  const fs::path root = fs::temp_directory_path() / "ademono_photo_office";
+  const fs::path root = fs::temp_directory_path() / ("ademono_photo_office_" + std::to_string(::getpid()));
   fs::remove_all(root);
   GeneratorOptions options;
   options.scene.scene = "office";
