@@ -31,6 +31,7 @@
 #include "ademono/slam/system.h"
 #include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
+#include "slam/simulated_network.h"  // tests/: the tests' simulated network
 
 namespace {
 
@@ -116,14 +117,6 @@ SystemOptions Options(Variant variant) {
   return options;
 }
 
-// Back and forth over the first `period` frames of the office path: 0, 1, ..., P-1, P-2, ..., 1,
-// 0, 1, ... A continuous path (no jump), revisiting the same places, so the map can saturate.
-size_t SourceFrame(size_t k, size_t period) {
-  const size_t cycle = 2 * period - 2;
-  const size_t m = k % cycle;
-  return m < period ? m : cycle - m;
-}
-
 void BM_Soak(benchmark::State& state) {
   const auto variant = static_cast<Variant>(state.range(0));
   // ADEMONO_SOAK_LOG=debug: the library's debug log (keyframe decisions, local mapping) on stderr.
@@ -142,12 +135,7 @@ void BM_Soak(benchmark::State& state) {
   const synth::Scene scene = synth::BuildScene(scene_options);
   synth::GeneratorOptions generator;
   generator.scene = scene_options;
-  SimulatedDepthOptions depth_options;
-  depth_options.scale = 0.88;
-  depth_options.jitter = 0.16;
-  depth_options.jitter_frames = 60;
-  depth_options.seed = 3;
-  const SimulatedDepthProvider network(depth_options, nullptr);
+  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(60, 3), nullptr);
 
   std::fprintf(stderr, "soak %s: %zu frames (back and forth over %zu), 320x240\n",
                kVariantNames[variant], frames, period);
@@ -161,7 +149,7 @@ void BM_Soak(benchmark::State& state) {
     double window_cpu_start = ProcessCpuSeconds();
     int lost_in_window = 0;
     for (size_t k = 0; k < frames; ++k) {
-      const size_t source = SourceFrame(k, period);
+      const size_t source = testing_util::BackAndForthFrame(k, period);
       const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, source, generator);
       FrameData frame;
       frame.index = k;

@@ -30,6 +30,28 @@ double MaxCentreError(const std::vector<Sim3d>& a, const std::vector<Sim3d>& b) 
   return worst;
 }
 
+// Odometry around the ring `truth`: each step cam_k_from_cam_{k-1} as `perturb` makes it, chained
+// from the first (fixed) camera into `drifted`, and closed by one exact loop edge from the last
+// camera to the first.
+template <typename Perturb>
+PoseGraphProblem DriftedRingWithLoop(const std::vector<Sim3d>& truth, Perturb perturb,
+                                     std::vector<Sim3d>* drifted) {
+  const size_t n = truth.size();
+  PoseGraphProblem problem;
+  drifted->assign(1, truth[0]);
+  for (size_t k = 1; k < n; ++k) {
+    const Sim3d noisy = perturb(k, truth[k] * truth[k - 1].Inverse());
+    drifted->push_back(noisy * drifted->back());
+    problem.edges.push_back({k, k - 1, noisy});  // the edges measure the drifted odometry
+  }
+  problem.edges.push_back({n - 1, 0, truth[n - 1] * truth[0].Inverse()});
+  problem.cam_from_world = *drifted;
+  problem.fixed.assign(n, false);
+  problem.fixed[0] = true;
+  problem.iterations = 50;
+  return problem;
+}
+
 TEST(Sim3d, ComposeAndInverse) {
   Sim3d s;
   s.scale = 1.3;
@@ -48,26 +70,18 @@ TEST(PoseGraph, LoopEdgeRemovesAccumulatedDrift) {
   const int n = 24;
   const std::vector<Sim3d> truth = Ring(n);
   // Drifted chain: each odometry step shrinks the scale by 3 % (a Sim(3) step, as a drifting
-  // network scale) and adds a 1 degree error about the camera's y axis, accumulated from the
-  // first (fixed) camera.
-  std::vector<Sim3d> drifted{truth[0]};
-  PoseGraphProblem problem;
-  for (int k = 1; k < n; ++k) {
-    Sim3d step = truth[k] * truth[k - 1].Inverse();  // cam_k_from_cam_{k-1}
-    Sim3d noisy = step;
-    noisy.scale = 0.97;
-    noisy.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())) *
-                     noisy.rotation;
-    drifted.push_back(noisy * drifted.back());
-    // The edges measure the drifted odometry.
-    problem.edges.push_back({static_cast<size_t>(k), static_cast<size_t>(k - 1), noisy});
-  }
-  // The loop edge: the last camera relative to the first, measured correctly.
-  problem.edges.push_back({static_cast<size_t>(n - 1), 0, truth[n - 1] * truth[0].Inverse()});
-  problem.cam_from_world = drifted;
-  problem.fixed.assign(n, false);
-  problem.fixed[0] = true;
-  problem.iterations = 50;
+  // network scale) and adds a 1 degree error about the camera's y axis; the loop edge is exact.
+  std::vector<Sim3d> drifted;
+  const PoseGraphProblem problem = DriftedRingWithLoop(
+      truth,
+      [](size_t, Sim3d step) {
+        step.scale = 0.97;
+        step.rotation =
+            Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d::UnitY())) *
+            step.rotation;
+        return step;
+      },
+      &drifted);
   const double before = MaxCentreError(drifted, truth);
   ASSERT_GT(before, 0.5);
   const PoseGraphResult result = SolvePoseGraph(problem);
@@ -106,19 +120,14 @@ TEST(PoseGraph, DepthWeightedTranslationTurnsTheChainLess) {
   const int n = 80;
   const double depth = 25;
   const std::vector<Sim3d> truth = Ring(n, 40.0);
-  std::vector<Sim3d> drifted{truth[0]};
-  PoseGraphProblem problem;
-  for (int k = 1; k < n; ++k) {
-    Sim3d noisy = truth[k] * truth[k - 1].Inverse();  // cam_k_from_cam_{k-1}
-    if (k > 10 && k <= 30) noisy.translation += Eigen::Vector3d(0.04, 0, 0);
-    drifted.push_back(noisy * drifted.back());
-    problem.edges.push_back({static_cast<size_t>(k), static_cast<size_t>(k - 1), noisy});
-  }
-  problem.edges.push_back({static_cast<size_t>(n - 1), 0, truth[n - 1] * truth[0].Inverse()});
-  problem.cam_from_world = drifted;
-  problem.fixed.assign(n, false);
-  problem.fixed[0] = true;
-  problem.iterations = 50;
+  std::vector<Sim3d> drifted;
+  const PoseGraphProblem problem = DriftedRingWithLoop(
+      truth,
+      [](size_t k, Sim3d step) {
+        if (k > 10 && k <= 30) step.translation += Eigen::Vector3d(0.04, 0, 0);
+        return step;
+      },
+      &drifted);
   const double before = MaxCentreError(drifted, truth);
   ASSERT_GT(before, 0.5);
   ASSERT_LT(MaxRotationError(drifted, truth), 1e-9);

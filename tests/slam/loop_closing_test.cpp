@@ -11,6 +11,7 @@
 #include "ademono/slam/system.h"
 #include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
+#include "simulated_network.h"
 
 namespace ademono {
 namespace {
@@ -23,18 +24,7 @@ struct LoopRun {
 };
 
 SystemOptions NetworkOptions(bool loop) {
-  SystemOptions options;
-  options.orb.num_features = 1000;
-  options.depth.virtual_baseline = 0.03;
-  options.depth.close_depth_factor = 107;
-  options.depth.error_relative = 0.5;
-  options.depth.edge_radius = 3;
-  options.depth.edge_relative_slope = 0.2;
-  options.tracking.min_init_points = 50;
-  options.tracking.close_tracked_min = 250;
-  options.mapping.ba_max_keyframes = 20;
-  options.mapping.triangulation = true;
-  options.filter.enable_dynamic_removal = false;
+  SystemOptions options = testing_util::SimulatedNetworkOptions();
   options.loop.enabled = loop;
   return options;
 }
@@ -44,12 +34,7 @@ LoopRun RunScene(const synth::SceneOptions& scene_options, const SystemOptions& 
   const synth::Scene scene = synth::BuildScene(scene_options);
   synth::GeneratorOptions generator;
   generator.scene = scene_options;
-  SimulatedDepthOptions depth_options;
-  depth_options.scale = 0.88;
-  depth_options.jitter = 0.16;
-  depth_options.jitter_frames = 200;
-  depth_options.seed = depth_seed;
-  const SimulatedDepthProvider network(depth_options, nullptr);
+  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(200, depth_seed), nullptr);
   LoopRun run;
   System system(scene.camera, options);
   for (size_t k = 0; k < scene_options.frames; ++k) {

@@ -15,6 +15,7 @@
 #include "ademono/slam/system.h"
 #include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
+#include "simulated_network.h"
 
 namespace ademono {
 namespace {
@@ -27,22 +28,9 @@ struct NetworkRun {
 };
 
 SystemOptions NetworkOptions(bool scale_correction) {
-  SystemOptions options;
-  options.orb.num_features = 1000;
-  options.depth.min_depth = 0.1;
-  options.depth.max_depth = 10.0;
-  options.depth.virtual_baseline = 0.03;
-  options.depth.close_depth_factor = 107;
-  options.depth.error_relative = 0.5;
+  SystemOptions options = testing_util::SimulatedNetworkOptions();
   options.depth.scale_correction = scale_correction;
   options.depth.anchor_scale = scale_correction;
-  options.depth.edge_radius = 3;
-  options.depth.edge_relative_slope = 0.2;
-  options.tracking.min_init_points = 50;
-  options.tracking.close_tracked_min = 250;
-  options.mapping.ba_max_keyframes = 20;
-  options.mapping.triangulation = true;
-  options.filter.enable_dynamic_removal = false;
   return options;
 }
 
@@ -56,12 +44,7 @@ NetworkRun RunOffice(bool scale_correction, size_t frames) {
   synth::GeneratorOptions generator;
   generator.scene = scene_options;
 
-  SimulatedDepthOptions depth_options;
-  depth_options.scale = 0.88;  // FastDepth reads about 0.88x the sensor on seq-a
-  depth_options.jitter = 0.16;
-  depth_options.jitter_frames = 60;
-  depth_options.seed = 3;
-  const SimulatedDepthProvider network(depth_options, nullptr);
+  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(60, 3), nullptr);
 
   NetworkRun run;
   System system(scene.camera, NetworkOptions(scale_correction));
@@ -135,7 +118,7 @@ TEST(NetworkDepthTest, RevisitedPlaceMakesFewKeyframes) {
   options.filter.enable_dynamic_removal = false;
   options.mapping.threaded = false;  // the count must not depend on the thread schedule
 
-  const size_t period = 40, frames = 2 * (2 * period - 2);
+  const size_t period = 40, cycle = 2 * period - 2, frames = 2 * cycle;
   synth::SceneOptions scene_options;
   scene_options.scene = "office";
   scene_options.frames = period;
@@ -146,19 +129,13 @@ TEST(NetworkDepthTest, RevisitedPlaceMakesFewKeyframes) {
   const synth::Scene scene = synth::BuildScene(scene_options);
   synth::GeneratorOptions generator;
   generator.scene = scene_options;
-  SimulatedDepthOptions depth_options;
-  depth_options.scale = 0.88;
-  depth_options.jitter = 0.16;
-  depth_options.jitter_frames = 60;
-  depth_options.seed = 3;
-  const SimulatedDepthProvider network(depth_options, nullptr);
+  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(60, 3), nullptr);
 
   System system(scene.camera, options);
   int tracked = 0, keyframes_last_pass = 0;
   for (size_t k = 0; k < frames; ++k) {
-    const size_t cycle = 2 * period - 2, m = k % cycle;
-    const size_t source = m < period ? m : cycle - m;
-    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, source, generator);
+    const synth::RenderedFrame rendered =
+        synth::RenderSceneFrame(scene, testing_util::BackAndForthFrame(k, period), generator);
     FrameData frame;
     frame.index = k;
     frame.timestamp = k / scene.fps;
