@@ -132,12 +132,8 @@ class DepthOfSource : public DepthProvider {
  public:
   explicit DepthOfSource(const Sequence& source) : source_(source) {}
   std::string Name() const override { return "depth-of-source"; }
-  cv::Mat Depth(const FrameData& frame, const Camera&) override {
-    cv::Mat depth = source_.Load(frame.index).depth.clone();
-    depth.forEach<float>([](float& z, const int*) {
-      if (!std::isfinite(z) || z < 0.f) z = 0.f;
-    });
-    return depth;
+  cv::Mat Depth(const FrameData& frame, const Camera& camera) override {
+    return runner_test::FrameDepth().Depth(source_.Load(frame.index), camera);
   }
 
  private:

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ademono/depth/sensor_depth.h"
 #include "ademono/perception/depth_provider.h"
 #include "ademono/perception/detection.h"
 #include "ademono/perception/detection_io.h"
@@ -17,17 +18,12 @@
 
 namespace ademono::runner_test {
 
-// The sequence's own depth, non-finite readings as 0 (what `--depth sensor` gives).
-class FrameDepth : public DepthProvider {
+// The sequence's own depth, non-finite readings as 0: `--depth sensor`'s provider under its own
+// name, so tests can tell it was the one used.
+class FrameDepth : public SensorDepthProvider {
  public:
+  FrameDepth() : SensorDepthProvider(nullptr) {}
   std::string Name() const override { return "frame-depth"; }
-  cv::Mat Depth(const FrameData& frame, const Camera&) override {
-    cv::Mat depth = frame.depth.clone();
-    depth.forEach<float>([](float& z, const int*) {
-      if (!std::isfinite(z) || z < 0.f) z = 0.f;
-    });
-    return depth;
-  }
 };
 
 // The synthetic sequence's detections.jsonl, matched by frame index.

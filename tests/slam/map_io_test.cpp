@@ -28,11 +28,7 @@ SystemOptions TestOptions() {
 void Track(System& system, const Sequence& sequence, std::vector<TrackResult>* results = nullptr) {
   for (size_t i = 0; i < sequence.Size(); ++i) {
     const FrameData frame = sequence.Load(i);
-    cv::Mat depth = frame.depth.clone();
-    depth.forEach<float>([](float& z, const int*) {
-      if (!std::isfinite(z) || z < 0.f) z = 0.f;
-    });
-    const TrackResult r = system.TrackFrame(frame, depth, {});
+    const TrackResult r = system.TrackFrame(frame, testing_util::SensorDepth(frame), {});
     if (results != nullptr) results->push_back(r);
   }
   system.Shutdown();

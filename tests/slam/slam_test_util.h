@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "ademono/depth/sensor_depth.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
 
@@ -13,6 +14,13 @@ namespace ademono::testing_util {
 
 inline std::string SevenScenesSpec() {
   return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a";
+}
+
+// The frame's depth as `--depth sensor` gives it (non-finite readings as 0); a frame without depth
+// (Fault::kNoDepth) stays without, so System's own handling of it is what the tests see.
+inline cv::Mat SensorDepth(const FrameData& frame) {
+  if (frame.depth.empty()) return {};
+  return SensorDepthProvider(nullptr).Depth(frame, Camera{});
 }
 
 enum class Fault { kNone, kNoDepth, kBlack };
