@@ -6,8 +6,10 @@
 //                    depth, filters, tracking, and local mapping in deterministic mode).
 // Frames 0..kFrames-1 are loaded once; when they run out a fresh System starts again (untimed).
 #include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "ademono/depth/depth_factory.h"
@@ -41,17 +43,12 @@ const Data& LoadData() {
   return data;
 }
 
+// configs/7scenes.yaml, what `ademono run --dataset 7scenes:...` uses, with local mapping on the
+// calling thread so that BM_FrameNoDepthNoDetection's time includes it.
 ademono::SystemOptions BenchOptions() {
-  // The settings of configs/7scenes.yaml that differ from the defaults.
-  ademono::SystemOptions options;
-  options.depth.min_depth = 0.3;
-  options.depth.max_depth = 6.0;
-  options.depth.virtual_baseline = 0.03;
-  options.depth.close_depth_factor = 107;
-  options.depth.edge_radius = 3;
-  options.depth.edge_relative_jump = 0.03;
-  options.tracking.close_tracked_min = 250;
-  options.mapping.ba_max_keyframes = 20;
+  const std::string path = std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml";
+  ademono::SystemOptions options = ademono::SystemOptions::FromYaml(YAML::LoadFile(path), path);
+  options.mapping.threaded = false;
   return options;
 }
 
