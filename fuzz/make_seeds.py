@@ -88,13 +88,14 @@ ok, tiff = cv2.imencode(".tiff", metres)
 seed("depth_image", "metres32.tiff", b"\1" + tiff.tobytes())
 
 # Map files (map_file): a two-keyframe map in the layout of slam/map_io.h (cereal portable binary:
-# a byte 1 for little-endian, then the fields; lengths as uint64), once as a whole file and once
-# as a bare payload (the target wraps inputs without the magic in a valid header).
+# a byte 1 for little-endian, then the fields; lengths as uint64), in format 2 as a whole file and
+# as a bare payload (the target wraps inputs without the magic in a format-2 header), and in
+# format 1 (no static probability or admission per point) as a whole file.
 import struct
 import zlib
 
 
-def map_payload():
+def map_payload(version):
     b = bytearray(b"\x01")
     b += struct.pack("<ii4d5d", 640, 480, 585.0, 585.0, 320.0, 240.0, 0, 0, 0, 0, 0)
     options = b"orb:\n  num_features: 1000\n"
@@ -115,10 +116,13 @@ def map_payload():
     b += struct.pack("<Q3d3d", 0, 0.1, 0.2, 1.5, 0, 0, 1) + bytes(range(32))
     b += struct.pack("<ffQQQiii", 0.5, 3.0, 0, 0, 0, 2, 2, 0)
     b += struct.pack("<Q", 2) + struct.pack("<QI", 0, 0) + struct.pack("<QI", 1, 0)
+    if version >= 2:
+        b += struct.pack("<dB", 0.45, 0)  # static probability, not admitted
     return bytes(b)
 
 
-payload = map_payload()
-seed("map_file", "two_keyframes.map",
-     b"ADEMAP\r\n" + struct.pack("<IQI", 1, len(payload), zlib.crc32(payload)) + payload)
-seed("map_file", "two_keyframes.payload", payload)
+for version, name in ((2, "two_keyframes.map"), (1, "two_keyframes_v1.map")):
+    payload = map_payload(version)
+    seed("map_file", name,
+         b"ADEMAP\r\n" + struct.pack("<IQI", version, len(payload), zlib.crc32(payload)) + payload)
+seed("map_file", "two_keyframes.payload", map_payload(2))

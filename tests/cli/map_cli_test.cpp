@@ -65,7 +65,7 @@ TEST_F(MapCliTest, LocalizeOnlyTracksEveryFrameWithinTheBoundAndLeavesTheFile) {
 TEST_F(MapCliTest, MapInfoPrintsWhatTheMapHolds) {
   const CliResult r = RunCli("map info " + MapPath().string());
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("format version: 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("format version: 2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("camera: 640x480 fx 585"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("keyframes: "), std::string::npos);
   EXPECT_NE(r.out.find("map points: "), std::string::npos);

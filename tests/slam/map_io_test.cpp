@@ -289,6 +289,60 @@ TEST_F(MapIoTest, BadMapsFailWithOneLineNamingTheFile) {
   data = LoadMapFile(MapPath());
   data.keyframes.front().weight_by_error_model = 3;
   expect_error(SerializeMapFile(data), "bad weight_by_error_model flag");
+  data = LoadMapFile(MapPath());
+  data.points.front().static_probability = 1.5;
+  expect_error(SerializeMapFile(data), "static probability outside [0, 1]");
+  data = LoadMapFile(MapPath());
+  data.points.front().admitted = 2;
+  expect_error(SerializeMapFile(data), "admitted flag is neither 0 nor 1");
+}
+
+// Format 2 keeps each point's static probability and admission: the geometric test's belief
+// survives a reload, so points a mover left unconfirmed stay out of localisation.
+TEST_F(MapIoTest, StaticProbabilityAndAdmissionSurviveTheRoundTrip) {
+  const MapFileData data = LoadMapFile(MapPath());
+  EXPECT_EQ(data.version, kMapFormatVersion);
+  size_t not_admitted = 0, below_one = 0;
+  for (const MapPointRecord& p : data.points) {
+    not_admitted += p.admitted == 0;
+    below_one += p.static_probability < 1;
+  }
+  // The last keyframes' points still wait for a confirming view.
+  EXPECT_GT(not_admitted, 0u);
+  EXPECT_GE(below_one, not_admitted);
+  // Loaded to be extended, the map is written from the restored points themselves (not the
+  // loaded records): the same bytes, so every point got its probability and flag back.
+  System system(Slice(0, 1)->GetCamera(), TestOptions());
+  system.LoadMap(MapPath(), false);
+  const fs::path again = *dir_ / "extended_nothing.map";
+  system.SaveMap(again);
+  EXPECT_TRUE(ReadBytes(again) == ReadBytes(MapPath()));
+  // Version 1 semantics for the same map: every point static and admitted.
+  MapFileData all_static = data;
+  for (MapPointRecord& p : all_static.points) p.static_probability = 1, p.admitted = 1;
+  EXPECT_FALSE(SerializeMapFile(all_static) == ReadBytes(MapPath()));
+}
+
+// A version 1 file (before static probabilities were saved) still loads, every point static and
+// admitted as version 1 meant, and saves back to its own bytes.
+TEST_F(MapIoTest, VersionOneMapsAreStillRead) {
+  MapFileData data = LoadMapFile(MapPath());
+  data.version = 1;
+  const std::string v1 = SerializeMapFile(data);
+  EXPECT_EQ(v1[8], 1);
+  EXPECT_LT(v1.size(), ReadBytes(MapPath()).size());  // no static fields
+  const fs::path path = *dir_ / "v1.map";
+  WriteBytes(path, v1);
+  const MapFileData read = LoadMapFile(path);
+  EXPECT_EQ(read.version, 1u);
+  ASSERT_EQ(read.points.size(), data.points.size());
+  for (const MapPointRecord& p : read.points) {
+    EXPECT_EQ(p.static_probability, 1.0);
+    EXPECT_EQ(p.admitted, 1);
+  }
+  EXPECT_TRUE(SerializeMapFile(read) == v1);
+  EXPECT_NE(MapSummaryText(path, SummarizeMap(read, v1.size())).find("format version: 1"),
+            std::string::npos);
 }
 
 TEST_F(MapIoTest, CameraThatDiffersFromTheSequenceIsRejected) {
@@ -313,7 +367,11 @@ TEST_F(MapIoTest, SummaryCountsWhatTheMapHolds) {
   EXPECT_GE(s.num_observations, points_);
   EXPECT_TRUE((s.min_corner.array() < s.max_corner.array()).all());
   const std::string text = MapSummaryText(MapPath(), s);
-  EXPECT_NE(text.find("format version: 1"), std::string::npos);
+  EXPECT_NE(text.find("format version: 2"), std::string::npos);
+  EXPECT_GT(s.num_points_not_admitted, 0u);
+  EXPECT_NE(text.find("map points: " + std::to_string(points_) + " (" +
+                      std::to_string(s.num_points_not_admitted) + " not admitted"),
+            std::string::npos);
   EXPECT_NE(text.find("keyframes: " + std::to_string(keyframes_)), std::string::npos);
   EXPECT_NE(text.find("tracking:"), std::string::npos);  // the options
 }

@@ -28,6 +28,17 @@ namespace {
 // before anything is allocated (cereal's own vector/string loaders would resize to whatever a
 // corrupt length says). Writing: unbounded.
 thread_local uint64_t t_payload_limit = std::numeric_limits<uint64_t>::max();
+// The format version of the payload being written or read (fields added in later versions are
+// skipped for older ones).
+thread_local uint32_t t_format_version = kMapFormatVersion;
+
+// Sets t_format_version for one archive operation.
+struct FormatVersionScope {
+  explicit FormatVersionScope(uint32_t version) { t_format_version = version; }
+  ~FormatVersionScope() { t_format_version = kMapFormatVersion; }
+  FormatVersionScope(const FormatVersionScope&) = delete;
+  FormatVersionScope& operator=(const FormatVersionScope&) = delete;
+};
 
 void CheckLength(uint64_t count, uint64_t min_element_bytes) {
   if (count > t_payload_limit / std::max<uint64_t>(1, min_element_bytes))
@@ -85,6 +96,7 @@ void serialize(Archive& ar, MapPointRecord& p) {
   ar(p.id, p.position, p.normal, p.descriptor, p.min_distance, p.max_distance, p.reference,
      p.first_keyframe_id, p.first_frame_id, p.visible, p.found, p.dynamic_hits);
   Elements(ar, p.observations, 12);
+  if (t_format_version >= 2) ar(p.static_probability, p.admitted);
 }
 
 template <class Archive>
@@ -206,6 +218,9 @@ void Validate(const MapFileData& d, const std::filesystem::path& path) {
       if (!Finite(v)) fail(where + "normal is not finite");
     if (!std::isfinite(p.min_distance) || !std::isfinite(p.max_distance))
       fail(where + "bad distance range");
+    if (!(p.static_probability >= 0 && p.static_probability <= 1))
+      fail(where + "static probability outside [0, 1]");
+    if (p.admitted > 1) fail(where + "admitted flag is neither 0 nor 1");
     if (p.observations.empty()) fail(where + "no observation");
     for (const auto& [kf, idx] : p.observations) {
       const auto it = num_keypoints.find(kf);
@@ -267,6 +282,8 @@ MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptio
     r.visible = p->visible;
     r.found = p->found;
     r.dynamic_hits = p->dynamic_hits;
+    r.static_probability = p->static_probability;
+    r.admitted = p->admitted ? 1 : 0;
     for (const auto& [kf, idx] : p->observations)
       if (!kf->bad) r.observations.emplace_back(kf->id, static_cast<uint32_t>(idx));
     if (r.observations.empty()) continue;
@@ -279,13 +296,17 @@ MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptio
 
 std::string SerializeMapFile(const MapFileData& data) {
   std::ostringstream payload_stream(std::ios::binary);
+  if (data.version < kMapOldestReadableVersion || data.version > kMapFormatVersion)
+    throw std::invalid_argument("SerializeMapFile: no format version " +
+                                std::to_string(data.version));
   {
+    const FormatVersionScope scope(data.version);
     cereal::PortableBinaryOutputArchive archive(payload_stream);
     archive(data);
   }
   const std::string payload = payload_stream.str();
   std::string out(kMagic, sizeof(kMagic));
-  PutLittleEndian<uint32_t>(out, kMapFormatVersion);
+  PutLittleEndian<uint32_t>(out, data.version);
   PutLittleEndian<uint64_t>(out, payload.size());
   PutLittleEndian<uint32_t>(out, Crc32(payload.data(), payload.size()));
   out += payload;
@@ -299,9 +320,11 @@ MapFileData ParseMapFile(const std::string& bytes, const std::filesystem::path& 
     ThrowInputError(path, "truncated map file (" + std::to_string(bytes.size()) +
                               " bytes, header needs " + std::to_string(kMapHeaderSize) + ")");
   const uint32_t version = GetLittleEndian<uint32_t>(bytes, 8);
-  if (version != kMapFormatVersion)
+  if (version < kMapOldestReadableVersion || version > kMapFormatVersion)
     ThrowInputError(path, "map format version " + std::to_string(version) +
-                              ", this build reads version " + std::to_string(kMapFormatVersion));
+                              ", this build reads versions " +
+                              std::to_string(kMapOldestReadableVersion) + " to " +
+                              std::to_string(kMapFormatVersion));
   const uint64_t payload_size = GetLittleEndian<uint64_t>(bytes, 12);
   const uint64_t available = bytes.size() - kMapHeaderSize;
   if (payload_size > available)
@@ -318,7 +341,9 @@ MapFileData ParseMapFile(const std::string& bytes, const std::filesystem::path& 
     explicit LimitGuard(uint64_t limit) { t_payload_limit = limit; }
     ~LimitGuard() { t_payload_limit = std::numeric_limits<uint64_t>::max(); }
   } guard(payload_size);
+  data.version = version;
   try {
+    const FormatVersionScope scope(version);
     std::istringstream in(bytes.substr(kMapHeaderSize), std::ios::binary);
     cereal::PortableBinaryInputArchive archive(in);
     archive(data);
@@ -379,7 +404,7 @@ void SaveMapFile(const std::filesystem::path& path, const MapFileData& data) {
 
 MapFileSummary SummarizeMap(const MapFileData& data, uint64_t file_size) {
   MapFileSummary s;
-  s.version = kMapFormatVersion;
+  s.version = data.version;
   s.file_size = file_size;
   s.camera = data.camera;
   s.num_keyframes = data.keyframes.size();
@@ -392,6 +417,7 @@ MapFileSummary SummarizeMap(const MapFileData& data, uint64_t file_size) {
     s.max_corner = first ? x : s.max_corner.cwiseMax(x);
     first = false;
     s.num_observations += p.observations.size();
+    if (p.admitted == 0) ++s.num_points_not_admitted;
   }
   return s;
 }
@@ -407,7 +433,8 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
     << s.camera.distortion[0] << ", " << s.camera.distortion[1] << ", " << s.camera.distortion[2]
     << ", " << s.camera.distortion[3] << ", " << s.camera.distortion[4] << "]\n";
   o << "keyframes: " << s.num_keyframes << "\n";
-  o << "map points: " << s.num_points << "\n";
+  o << "map points: " << s.num_points << " (" << s.num_points_not_admitted
+    << " not admitted: awaiting a confirming view or judged moving)\n";
   o << "observations: " << s.num_observations << "\n";
   o << "bounding box (m): min [" << s.min_corner.x() << ", " << s.min_corner.y() << ", "
     << s.min_corner.z() << "] max [" << s.max_corner.x() << ", " << s.max_corner.y() << ", "
@@ -479,6 +506,8 @@ void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyrami
     p->visible = r.visible;
     p->found = r.found;
     p->dynamic_hits = r.dynamic_hits;
+    p->static_probability = r.static_probability;
+    p->admitted = r.admitted != 0;
     for (const auto& [id, idx] : r.observations) {
       KeyFrame* kf = keyframes.at(id);
       p->AddObservation(kf, idx);

@@ -23,7 +23,10 @@
 
 namespace ademono {
 
-constexpr uint32_t kMapFormatVersion = 1;
+// 2: map points carry the geometric test's static probability and whether they were admitted.
+// Version 1 files (without them: every point static and admitted) are still read.
+constexpr uint32_t kMapFormatVersion = 2;
+constexpr uint32_t kMapOldestReadableVersion = 1;
 constexpr size_t kMapHeaderSize = 24;
 
 struct MapKeyPointRecord {
@@ -57,9 +60,17 @@ struct MapPointRecord {
   uint64_t reference = 0, first_keyframe_id = 0, first_frame_id = 0;
   int32_t visible = 1, found = 1, dynamic_hits = 0;
   std::vector<std::pair<uint64_t, uint32_t>> observations;  // (keyframe id, keypoint index)
+  // Version 2: P(static) and whether the point was let into the pose and BA, so a reloaded map
+  // keeps a mover's unconfirmed points out of localisation as the live map did. A byte for the
+  // flag, as for weight_by_error_model.
+  double static_probability = 1;
+  uint8_t admitted = 1;
 };
 
 struct MapFileData {
+  // The file's format version (the header's; not in the payload). Written back as read, so a
+  // loaded map saves to the same bytes; new maps get kMapFormatVersion.
+  uint32_t version = kMapFormatVersion;
   Camera camera;
   std::string options_yaml;  // the resolved SystemOptions of the run that built the map
   uint64_t next_keyframe_id = 0, next_point_id = 0;
@@ -73,6 +84,7 @@ struct MapFileSummary {
   uint64_t file_size = 0;
   Camera camera;
   size_t num_keyframes = 0, num_points = 0, num_observations = 0;
+  size_t num_points_not_admitted = 0;  // awaiting a confirming view, or judged moving
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero(), max_corner = Eigen::Vector3d::Zero();
   std::string options_yaml;
 };
