@@ -91,6 +91,19 @@ TEST(StaticProbabilityTest, DepthIsJudgedAtTheDistanceItWasMeasuredAt) {
             StaticEvidence::kNone);
 }
 
+TEST(StaticProbabilityTest, PointDepthSigmaIsTheConfiguredNoiseOrTheErrorModel) {
+  StaticTestParams p;
+  // A sensor by default: no sigma, so no allowance (fixed pixel thresholds).
+  EXPECT_EQ(PointDepthSigma(20.0, p), 0.0);
+  // The street's simulated network: 1 % + 0.1 %/m, 3 % at 20 m.
+  p.point_sigma_relative = 0.01;
+  p.point_sigma_per_metre = 0.001;
+  EXPECT_NEAR(PointDepthSigma(20.0, p), 0.03, 1e-12);
+  // A depth error model that is wider wins; a narrower one does not narrow it.
+  EXPECT_NEAR(PointDepthSigma(20.0, p, 0.2), 0.2, 1e-12);
+  EXPECT_NEAR(PointDepthSigma(20.0, p, 0.01), 0.03, 1e-12);
+}
+
 TEST(StaticProbabilityTest, ResidualAllowanceWidensBothResidualBands) {
   const StaticTestParams p;  // 2.5 px static, 6 px motion
   EXPECT_EQ(JudgeObservation(8.0, 0.01, p), StaticEvidence::kDynamic);

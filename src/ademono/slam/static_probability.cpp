@@ -22,6 +22,8 @@ const OptionsTable<StaticTestParams>& StaticTestParams::Table() {
           .Add("static_depth_sigmas", &P::depth_sigmas, Range::Above(0))
           .Add("static_depth_dynamic_sigmas", &P::depth_dynamic_sigmas, Range::Above(0))
           .Add("static_parallax_sigmas", &P::parallax_sigmas, Range::AtLeast(0))
+          .Add("static_point_sigma_relative", &P::point_sigma_relative, Range::AtLeast(0))
+          .Add("static_point_sigma_per_metre", &P::point_sigma_per_metre, Range::AtLeast(0))
           .Add("static_depth_at_reference", &P::depth_at_reference);
   return table;
 }
@@ -52,6 +54,13 @@ double RelativeDepthDisagreement(double z_map, double z_measured, double referen
   if (params.depth_at_reference && std::isfinite(reference_distance))
     scale = std::max(scale, reference_distance);
   return std::abs(z_map - z_measured) / scale;
+}
+
+double PointDepthSigma(double distance, const StaticTestParams& params,
+                       double model_relative_sigma) {
+  const double configured = params.point_sigma_relative + params.point_sigma_per_metre * distance;
+  const double model = std::isfinite(model_relative_sigma) ? model_relative_sigma : 0.0;
+  return std::max({configured, model, 0.0});
 }
 
 double ParallaxShiftPx(const Eigen::Vector3d& point_world, const Eigen::Vector3d& ray_origin_world,

@@ -31,11 +31,16 @@ struct StaticTestParams {
   double depth_sigmas = 0.5;
   double depth_dynamic_sigmas = 1.0;
   // A map point's position is known only as well as the depth that made it: along the ray of the
-  // keyframe that measured it (its reference), within the static depth band above. Seen from
-  // another place, that uncertainty is a shift in the image, large for near points passed at
-  // speed. Both residual thresholds grow by `parallax_sigmas` times that shift (ParallaxShiftPx
-  // at the band, in the keypoint level's pixels); 0 = fixed pixel thresholds (docs/filters.md).
+  // keyframe that measured it (its reference), with that depth's sigma. Seen from another place,
+  // that uncertainty is a shift in the image, large for near points passed at speed. Both
+  // residual thresholds grow by `parallax_sigmas` times that shift (ParallaxShiftPx at
+  // PointDepthSigma, in the keypoint level's pixels). The sigma is the depth's error model when
+  // it has one, else sigma_z / z = point_sigma_relative + point_sigma_per_metre * z: 0 for a
+  // sensor by default (fixed pixel thresholds; a walker's points in a map made inside a crowd
+  // would hide within a 5 % band's shift), the simulated network's own noise in street.yaml.
   double parallax_sigmas = 3.0;
+  double point_sigma_relative = 0.0;
+  double point_sigma_per_metre = 0.0;
   // The map's depth of a point carries the error of the depth that made it, a fraction of the
   // distance it was measured at: approached at speed (made at 30 m, seen at 20 m), that is a
   // larger fraction of the depth measured now. true: the depth bands are relative to the larger
@@ -66,6 +71,12 @@ StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_
 // from the keyframe whose depth made it; <= 0 or not finite: unknown, z_measured alone).
 double RelativeDepthDisagreement(double z_map, double z_measured, double reference_distance,
                                  const StaticTestParams& params);
+
+// sigma_z / z of a map point's depth measured at `distance`: the larger of the configured
+// point_sigma_relative + point_sigma_per_metre * distance and the depth's error model
+// (`model_relative_sigma`, 0 without one).
+double PointDepthSigma(double distance, const StaticTestParams& params,
+                       double model_relative_sigma = 0.0);
 
 // How far (pixels, pinhole with focal lengths fx, fy) the projection into `cam_from_world` of
 // `point_world` moves when the point slides along the ray from `ray_origin_world` (the camera

@@ -670,16 +670,16 @@ int Tracking::JudgeStaticness(Frame& frame) {
         depth_error = RelativeDepthDisagreement(cam.z(), f.depth[i], distance, params);
         if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
       }
-      // The point's own uncertainty along the ray that measured it, seen from here: the depth
-      // band the test calls agreeing (wider with an error model) as a shift in the image.
+      // The point's own uncertainty along the ray that measured it, seen from here: its depth's
+      // sigma as a shift in the image.
       if (params.parallax_sigmas > 0 && has_ref) {
-        double band = params.depth_relative;
-        if (f.DepthIsPrior())
-          band = std::max(band, params.depth_sigmas * f.depth_error.RelativeSigma(distance));
-        allowance = params.parallax_sigmas *
-                    ParallaxShiftPx(p->position, origin, *frame.cam_from_world, f.intrinsics.fx,
-                                    f.intrinsics.fy, band) /
-                    level_scale;
+        const double sigma = PointDepthSigma(
+            distance, params, f.DepthIsPrior() ? f.depth_error.RelativeSigma(distance) : 0.0);
+        if (sigma > 0)
+          allowance = params.parallax_sigmas *
+                      ParallaxShiftPx(p->position, origin, *frame.cam_from_world,
+                                      f.intrinsics.fx, f.intrinsics.fy, sigma) /
+                      level_scale;
       }
     }
     const StaticEvidence evidence =
