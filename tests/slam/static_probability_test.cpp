@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "ademono/slam/system.h"
 #include "synthetic_sequence.h"
@@ -49,6 +50,71 @@ TEST(StaticProbabilityTest, DepthWithAnErrorModelIsJudgedAgainstItsSigma) {
   // A small sigma never narrows the sensor bands.
   EXPECT_EQ(JudgeObservation(1.0, 0.04, p, 0.01), StaticEvidence::kStatic);
   EXPECT_EQ(JudgeObservation(1.0, 0.1, p, 0.01), StaticEvidence::kNone);
+}
+
+TEST(StaticProbabilityTest, ParallaxShiftIsTheDepthBandSeenFromElsewhere) {
+  const Eigen::Vector3d point(0, 0, 10);
+  const Rigid3d cam_from_world = Rigid3d::Identity();
+  // Seen from the camera that measured it, a depth error moves the point along the line of
+  // sight: no shift in the image.
+  EXPECT_NEAR(ParallaxShiftPx(point, Eigen::Vector3d::Zero(), cam_from_world, 500, 500, 0.05), 0,
+              1e-9);
+  // Measured from 2 m to the left: the ray is (2, 0, 10); 5 % of it is (0.1, 0, 0.5). Nearer,
+  // the point projects at x/z = -0.1 / 9.5, farther at 0.1 / 10.5: the larger shift counts.
+  EXPECT_NEAR(ParallaxShiftPx(point, Eigen::Vector3d(-2, 0, 0), cam_from_world, 500, 500, 0.05),
+              500 * 0.1 / 9.5, 1e-9);
+  // Twice the band, about twice the shift; a nearer point, a larger shift for the same baseline.
+  EXPECT_NEAR(ParallaxShiftPx(point, Eigen::Vector3d(-2, 0, 0), cam_from_world, 500, 500, 0.1),
+              500 * 0.2 / 9.0, 1e-9);
+  EXPECT_GT(ParallaxShiftPx(Eigen::Vector3d(0, 0, 5), Eigen::Vector3d(-2, 0, 0), cam_from_world,
+                            500, 500, 0.05),
+            500 * 0.1 / 9.5);
+  // A shifted point behind the camera: no finite shift.
+  EXPECT_TRUE(std::isinf(ParallaxShiftPx(Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d(0, 0, -20),
+                                         cam_from_world, 500, 500, 0.05)));
+}
+
+TEST(StaticProbabilityTest, DepthIsJudgedAtTheDistanceItWasMeasuredAt) {
+  StaticTestParams p;
+  // Made from a depth taken 30 m away, with 5 % of error that is 1.5 m; seen now at 20 m, the
+  // map says 21.5 m: 7.5 % of the depth measured now, but 5 % of where it was measured.
+  EXPECT_NEAR(RelativeDepthDisagreement(21.5, 20.0, 30.0, p), 1.5 / 30.0, 1e-12);
+  EXPECT_EQ(JudgeObservation(1.0, RelativeDepthDisagreement(21.5, 20.0, 30.0, p), p),
+            StaticEvidence::kStatic);
+  // Seen from farther than it was made (or the reference unknown): the measured depth, as before.
+  EXPECT_NEAR(RelativeDepthDisagreement(21.5, 20.0, 10.0, p), 1.5 / 20.0, 1e-12);
+  EXPECT_NEAR(RelativeDepthDisagreement(21.5, 20.0, 0.0, p), 1.5 / 20.0, 1e-12);
+  // Switched off: the measured depth always.
+  p.depth_at_reference = false;
+  EXPECT_NEAR(RelativeDepthDisagreement(21.5, 20.0, 30.0, p), 1.5 / 20.0, 1e-12);
+  EXPECT_EQ(JudgeObservation(1.0, RelativeDepthDisagreement(21.5, 20.0, 30.0, p), p),
+            StaticEvidence::kNone);
+}
+
+TEST(StaticProbabilityTest, PointDepthSigmaIsTheConfiguredNoiseOrTheErrorModel) {
+  StaticTestParams p;
+  // A sensor by default: no sigma, so no allowance (fixed pixel thresholds).
+  EXPECT_EQ(PointDepthSigma(20.0, p), 0.0);
+  // The street's simulated network: 1 % + 0.1 %/m, 3 % at 20 m.
+  p.point_sigma_relative = 0.01;
+  p.point_sigma_per_metre = 0.001;
+  EXPECT_NEAR(PointDepthSigma(20.0, p), 0.03, 1e-12);
+  // A depth error model that is wider wins; a narrower one does not narrow it.
+  EXPECT_NEAR(PointDepthSigma(20.0, p, 0.2), 0.2, 1e-12);
+  EXPECT_NEAR(PointDepthSigma(20.0, p, 0.01), 0.03, 1e-12);
+}
+
+TEST(StaticProbabilityTest, ResidualAllowanceWidensBothResidualBands) {
+  const StaticTestParams p;  // 2.5 px static, 6 px motion
+  EXPECT_EQ(JudgeObservation(8.0, 0.01, p), StaticEvidence::kDynamic);
+  EXPECT_EQ(JudgeObservation(8.0, 0.01, p, 0.0, 3.0), StaticEvidence::kNone);     // 8 <= 9
+  EXPECT_EQ(JudgeObservation(8.0, 0.01, p, 0.0, 6.0), StaticEvidence::kStatic);   // 8 <= 8.5
+  // The allowance is about the point's position, not its depth: depth motion stays motion.
+  EXPECT_EQ(JudgeObservation(1.0, 0.3, p, 0.0, 6.0), StaticEvidence::kDynamic);
+  // Nothing to allow (negative or not finite): the fixed bands.
+  EXPECT_EQ(JudgeObservation(8.0, 0.01, p, 0.0, -3.0), StaticEvidence::kDynamic);
+  EXPECT_EQ(JudgeObservation(8.0, 0.01, p, 0.0, std::numeric_limits<double>::infinity()),
+            StaticEvidence::kDynamic);
 }
 
 TEST(StaticProbabilityTest, MotionOutweighsAgreementAndStaysReversible) {

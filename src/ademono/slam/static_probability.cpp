@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "ademono/core/options_table.h"
 
@@ -19,25 +20,63 @@ const OptionsTable<StaticTestParams>& StaticTestParams::Table() {
           .Add("static_depth_relative", &P::depth_relative, Range::Above(0))
           .Add("static_depth_dynamic_relative", &P::depth_dynamic_relative, Range::Above(0))
           .Add("static_depth_sigmas", &P::depth_sigmas, Range::Above(0))
-          .Add("static_depth_dynamic_sigmas", &P::depth_dynamic_sigmas, Range::Above(0));
+          .Add("static_depth_dynamic_sigmas", &P::depth_dynamic_sigmas, Range::Above(0))
+          .Add("static_parallax_sigmas", &P::parallax_sigmas, Range::AtLeast(0))
+          .Add("static_point_sigma_relative", &P::point_sigma_relative, Range::AtLeast(0))
+          .Add("static_point_sigma_per_metre", &P::point_sigma_per_metre, Range::AtLeast(0))
+          .Add("static_depth_at_reference", &P::depth_at_reference);
   return table;
 }
 
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
-                                const StaticTestParams& params, double depth_relative_sigma) {
+                                const StaticTestParams& params, double depth_relative_sigma,
+                                double residual_allowance_px) {
   if (!std::isfinite(residual_px)) return StaticEvidence::kDynamic;
+  const double allowance =
+      std::isfinite(residual_allowance_px) ? std::max(residual_allowance_px, 0.0) : 0.0;
   const bool depth_known = depth_relative_error && std::isfinite(*depth_relative_error);
   const double sigma = std::isfinite(depth_relative_sigma) ? std::max(depth_relative_sigma, 0.0) : 0.0;
   const double static_band = std::max(params.depth_relative, params.depth_sigmas * sigma);
   const double dynamic_band =
       std::max(params.depth_dynamic_relative, params.depth_dynamic_sigmas * sigma);
-  if (residual_px > params.residual_dynamic_px ||
+  if (residual_px > params.residual_dynamic_px + allowance ||
       (depth_known && *depth_relative_error > dynamic_band))
     return StaticEvidence::kDynamic;
-  if (residual_px <= params.residual_px &&
+  if (residual_px <= params.residual_px + allowance &&
       (!depth_known || *depth_relative_error <= static_band))
     return StaticEvidence::kStatic;
   return StaticEvidence::kNone;
+}
+
+double RelativeDepthDisagreement(double z_map, double z_measured, double reference_distance,
+                                 const StaticTestParams& params) {
+  double scale = z_measured;
+  if (params.depth_at_reference && std::isfinite(reference_distance))
+    scale = std::max(scale, reference_distance);
+  return std::abs(z_map - z_measured) / scale;
+}
+
+double PointDepthSigma(double distance, const StaticTestParams& params,
+                       double model_relative_sigma) {
+  const double configured = params.point_sigma_relative + params.point_sigma_per_metre * distance;
+  const double model = std::isfinite(model_relative_sigma) ? model_relative_sigma : 0.0;
+  return std::max({configured, model, 0.0});
+}
+
+double ParallaxShiftPx(const Eigen::Vector3d& point_world, const Eigen::Vector3d& ray_origin_world,
+                       const Rigid3d& cam_from_world, double fx, double fy,
+                       double relative_depth) {
+  const Eigen::Vector3d cam = cam_from_world * point_world;
+  if (cam.z() <= 0) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d along = relative_depth * (point_world - ray_origin_world);
+  double shift = 0;
+  for (const double sign : {1.0, -1.0}) {
+    const Eigen::Vector3d moved = cam_from_world * (point_world + sign * along);
+    if (moved.z() <= 0) return std::numeric_limits<double>::infinity();
+    shift = std::max(shift, std::hypot(fx * (moved.x() / moved.z() - cam.x() / cam.z()),
+                                       fy * (moved.y() / moved.z() - cam.y() / cam.z())));
+  }
+  return shift;
 }
 
 double UpdateStaticProbability(double probability, StaticEvidence evidence) {

@@ -10,6 +10,8 @@
 
 #include <optional>
 
+#include "ademono/core/geometry.h"
+
 namespace ademono {
 
 template <typename Options>
@@ -28,6 +30,23 @@ struct StaticTestParams {
   // (a learned depth's 15-50 % error would otherwise read every static point as moving).
   double depth_sigmas = 0.5;
   double depth_dynamic_sigmas = 1.0;
+  // A map point's position is known only as well as the depth that made it: along the ray of the
+  // keyframe that measured it (its reference), with that depth's sigma. Seen from another place,
+  // that uncertainty is a shift in the image, large for near points passed at speed. Both
+  // residual thresholds grow by `parallax_sigmas` times that shift (ParallaxShiftPx at
+  // PointDepthSigma, in the keypoint level's pixels). The sigma is the depth's error model when
+  // it has one, else sigma_z / z = point_sigma_relative + point_sigma_per_metre * z: 0 for a
+  // sensor by default (fixed pixel thresholds; a walker's points in a map made inside a crowd
+  // would hide within a 5 % band's shift), the simulated network's own noise in street.yaml.
+  double parallax_sigmas = 3.0;
+  double point_sigma_relative = 0.0;
+  double point_sigma_per_metre = 0.0;
+  // The map's depth of a point carries the error of the depth that made it, a fraction of the
+  // distance it was measured at: approached at speed (made at 30 m, seen at 20 m), that is a
+  // larger fraction of the depth measured now. true: the depth bands are relative to the larger
+  // of the measured depth and the point's distance from its reference keyframe; false: to the
+  // measured depth alone.
+  bool depth_at_reference = true;
 
   // Its keys of the flat `tracking:` node (static_prior, ...; TrackingOptions holds them).
   static const OptionsTable<StaticTestParams>& Table();
@@ -41,8 +60,32 @@ enum class StaticEvidence { kNone, kStatic, kDynamic };
 // depth. Motion in either is evidence of motion; static needs both (when depth is known) agreeing.
 // `depth_relative_sigma` is the depth's error model sigma_z / z at the measured depth (0: a
 // sensor, judged by the fixed bands alone).
+// `residual_allowance_px` widens both residual thresholds (the point's own position
+// uncertainty seen from this frame, ParallaxShiftPx times parallax_sigmas).
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
-                                const StaticTestParams& params, double depth_relative_sigma = 0.0);
+                                const StaticTestParams& params, double depth_relative_sigma = 0.0,
+                                double residual_allowance_px = 0.0);
+
+// The disagreement |z_map - z_measured| the depth bands judge, relative to z_measured, or with
+// `depth_at_reference` to the larger of z_measured and `reference_distance` (the point's distance
+// from the keyframe whose depth made it; <= 0 or not finite: unknown, z_measured alone).
+double RelativeDepthDisagreement(double z_map, double z_measured, double reference_distance,
+                                 const StaticTestParams& params);
+
+// sigma_z / z of a map point's depth measured at `distance`: the larger of the configured
+// point_sigma_relative + point_sigma_per_metre * distance and the depth's error model
+// (`model_relative_sigma`, 0 without one).
+double PointDepthSigma(double distance, const StaticTestParams& params,
+                       double model_relative_sigma = 0.0);
+
+// How far (pixels, pinhole with focal lengths fx, fy) the projection into `cam_from_world` of
+// `point_world` moves when the point slides along the ray from `ray_origin_world` (the camera
+// centre that measured its depth) by `relative_depth` of its distance, nearer or farther (the
+// larger of the two). 0 seen from the ray's own origin; grows with the parallax between the two
+// views. Infinite when a shifted point lands behind the camera.
+double ParallaxShiftPx(const Eigen::Vector3d& point_world, const Eigen::Vector3d& ray_origin_world,
+                       const Rigid3d& cam_from_world, double fx, double fy,
+                       double relative_depth);
 
 // Bayes update of P(static) by one verdict (likelihood ratios 1.5 for static, 1/4 for motion),
 // clamped to [0.02, 0.98] so that a point can always change its mind.

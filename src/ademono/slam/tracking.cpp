@@ -13,6 +13,7 @@
 #include "ademono/core/cv_geometry.h"
 #include "ademono/optimize/depth_scale.h"
 #include "ademono/optimize/pose_optimizer.h"
+#include "ademono/slam/keyframe.h"
 #include "ademono/slam/matcher.h"
 #include "ademono/slam/static_probability.h"
 
@@ -653,6 +654,7 @@ int Tracking::JudgeStaticness(Frame& frame) {
     double residual = std::numeric_limits<double>::infinity();
     std::optional<double> depth_error;
     double depth_sigma = 0.0;
+    double allowance = 0.0;
     if (cam.z() > 0) {
       const cv::KeyPoint& kp = f.keypoints_un[i];
       const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
@@ -660,12 +662,28 @@ int Tracking::JudgeStaticness(Frame& frame) {
       // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
       const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
       residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
+      const KeyFrame* ref = p->reference;
+      const bool has_ref = ref != nullptr && !ref->bad;
+      const Eigen::Vector3d origin = has_ref ? ref->CameraCenter() : Eigen::Vector3d::Zero();
+      const double distance = has_ref ? (p->position - origin).norm() : 0.0;
       if (f.depth[i] > 0) {
-        depth_error = std::abs(cam.z() - f.depth[i]) / f.depth[i];
+        depth_error = RelativeDepthDisagreement(cam.z(), f.depth[i], distance, params);
         if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
       }
+      // The point's own uncertainty along the ray that measured it, seen from here: its depth's
+      // sigma as a shift in the image.
+      if (params.parallax_sigmas > 0 && has_ref) {
+        const double sigma = PointDepthSigma(
+            distance, params, f.DepthIsPrior() ? f.depth_error.RelativeSigma(distance) : 0.0);
+        if (sigma > 0)
+          allowance = params.parallax_sigmas *
+                      ParallaxShiftPx(p->position, origin, *frame.cam_from_world,
+                                      f.intrinsics.fx, f.intrinsics.fy, sigma) /
+                      level_scale;
+      }
     }
-    const StaticEvidence evidence = JudgeObservation(residual, depth_error, params, depth_sigma);
+    const StaticEvidence evidence =
+        JudgeObservation(residual, depth_error, params, depth_sigma, allowance);
     if (evidence == StaticEvidence::kDynamic) ++p->motion_verdicts;
     p->static_probability = UpdateStaticProbability(p->static_probability, evidence);
     if (UsableForPose(*p)) {
