@@ -225,23 +225,21 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   scene.world_from_cam = MakeCameraTrajectory(motion);
 }
 
-// The street's intersection (photos only), as on a KITTI drive: a city bus stands across the
-// junction (on the cross street's far lane, broadside to the camera); the camera's car brakes
-// (2 s, evenly) to a stop GAP m before the bus's line, the bus pulls away from right to left
-// (accelerating at 1.0-1.4 m/s^2 up to 6 m/s), the camera waits until it has cleared its lane
-// and pulls away too (2 s) back to its speed. The stop starts at 35-45 % of the drive. The lead car
-// turns right into the cross street's near lane (3.5 m short of the bus's line) before the
-// camera stops, so the two never meet. Drives shorter than 8 s have no stop (the bus stands
-// beyond the end of the drive and pulls away at mid-drive).
+// The street's intersection (photos only), as on a KITTI drive: a city bus crosses the junction
+// from right to left at a steady 2.5-3.5 m/s (on the cross street, broadside to the camera), so
+// it is moving whenever it is in view, as its ground truth says; the camera's car brakes (2 s,
+// evenly) to a stop GAP m before the bus's line as the bus's front enters its lane, waits until
+// the bus has cleared the lane and pulls away (2 s) back to its speed. The stop starts at
+// 35-45 % of the drive. The lead car turns right into the cross street's near lane (3.5 m short
+// of the bus's line) before the camera stops, so the two never meet. Drives shorter than 8 s have
+// no stop (the bus crosses beyond the end of the drive at mid-drive).
 struct Crossing {
   double speed = 10.0;                             // the camera's cruising speed, m/s
   double ramp_s = 2.0;                             // braking and pulling away
   double t_brake = 1e9, t_stop = 1e9, t_go = 1e9;  // s
-  double x_bus = 0.0;        // the bus's line (world x)
-  double y_rest = 0.0;       // the bus's middle while it stands
-  double t_start = 0.0;      // s, when the bus pulls away
-  double bus_accel = 1.0;    // m/s^2
-  double bus_top_speed = 6.0;  // m/s
+  double x_bus = 0.0;      // the bus's line (world x)
+  double t_mid = 0.0;      // s, when the bus's middle is on the camera's lane centre (y = -1.75)
+  double bus_speed = 3.0;  // m/s, along +y
   double x_street() const { return x_bus - 1.75; }  // the cross street's middle
   double x_turn() const { return x_bus - 3.5; }     // where the lead car turns
   // Distance the camera has driven along x at time t.
@@ -258,11 +256,7 @@ struct Crossing {
     return x_stop + speed * (0.5 * ramp_s + tau - ramp_s);
   }
   // The bus's middle along y at time t.
-  double BusY(double t) const {
-    const double tau = std::max(0.0, t - t_start), t_top = bus_top_speed / bus_accel;
-    if (tau <= t_top) return y_rest + 0.5 * bus_accel * tau * tau;
-    return y_rest + 0.5 * bus_accel * t_top * t_top + bus_top_speed * (tau - t_top);
-  }
+  double BusY(double t) const { return -1.75 + bus_speed * (t - t_mid); }
 };
 
 // The crossing vehicle's length: bus.jpg's bus is a minibus ("Un minibús 100% eléctrico" on its
@@ -275,22 +269,21 @@ Crossing PlanCrossing(uint64_t seed, double camera_speed, double duration, doubl
   crossing.speed = camera_speed;
   const double stop_at = rng.Uniform(0.35, 0.45) * duration;
   const double gap = rng.Uniform(6.5, 8.0);
-  crossing.y_rest = -1.75 - rng.Uniform(0.0, 2.0);
-  crossing.bus_accel = rng.Uniform(1.0, 1.4);
-  const double start_after = rng.Uniform(0.5, 1.0);
+  crossing.bus_speed = rng.Uniform(2.5, 3.5);
+  // The bus's front (half a length ahead of its middle) enters the lane (its right edge, y = -3.5)
+  // 0.0-0.5 s after the camera has stopped.
+  const double front_in = rng.Uniform(0.0, 0.5);
   if (duration >= 8.0) {
     crossing.t_stop = stop_at;
     crossing.t_brake = stop_at - crossing.ramp_s;
     crossing.x_bus = crossing.CameraX(stop_at) + gap;
-    crossing.t_start = stop_at + start_after;
+    crossing.t_mid = stop_at + front_in + (1.75 + 0.5 * bus_length_m) / crossing.bus_speed;
     // Clear of the camera's lane (its rear 1 m past the lane's middle), then 0.3 s.
     const double clear_y = -1.75 + 1.0 + 0.5 * bus_length_m;
-    double t = crossing.t_start;
-    while (crossing.BusY(t) < clear_y) t += 0.05;
-    crossing.t_go = t + 0.3;
+    crossing.t_go = crossing.t_mid + (clear_y + 1.75) / crossing.bus_speed + 0.3;
   } else {
     crossing.x_bus = camera_speed * duration + 2 * gap;
-    crossing.t_start = 0.5 * duration;
+    crossing.t_mid = 0.5 * duration;
   }
   return crossing;
 }
