@@ -15,6 +15,10 @@
 #   excluded by the geometric test when matched, the earlier definition, beside it);
 #   <= 10 % of static keypoints removed (labelled, excluded when matched, or their new point
 #   judged moving before it was admitted).
+# The ATE ratios are shown with se3 and sim3 alignment (with the sim3 scales): the simulated
+# network's constant scale error dominates the se3 ATE on the street and is the same in every
+# variant, so sim3 is the one that shows what the movers did. A second table gives YOLOX-nano's
+# recall of the street's bus and lead car and the share of pose inliers on movers.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${1:-$here/build/release/bin/ademono}"
@@ -68,15 +72,17 @@ def variants(path):
         return None
 def pct(a, b):
     return (100.0 * a / b, "%.1f%% (%d/%d)" % (100.0 * a / b, a, b)) if b else (None, "-")
-print("| scene | seed | YOLOX recall: persons / cars (photo movers) | ATE se3 yolox | ATE se3 gt boxes | ATE se3 no removal | yolox/gt <= 1.5 | yolox/none <= 0.3 | moving kept out of tracking and map >= 90% | moving labelled or excluded at match | of them unboxed | static removed <= 10% | tracked yolox / gt / none | ATE sim3 yolox / gt / none |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+print("| scene | seed | YOLOX recall: persons / cars (photo movers) | ATE se3 yolox | ATE se3 gt boxes | ATE se3 no removal | yolox/gt <= 1.5 | yolox/none <= 0.3 | moving kept out of tracking and map >= 90% | moving labelled or excluded at match | of them unboxed | static removed <= 10% | tracked yolox / gt / none | ATE sim3 yolox / gt / none | sim3 yolox/gt, yolox/none | scale yolox / gt / none |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 ok_all = True
+ok_sim3 = True
+sim3_rows = []
 for scene, seeds in (("office", office), ("street", street)):
     for seed in seeds:
         base = os.path.join(work, "%s_s%s" % (scene, seed))
         y, g = variants(base + "_yolox/ablation.json"), variants(base + "_gt/ablation.json")
         if not y or not g:
-            print("| %s | %s | missing results | | | | | | | | | | |" % (scene, seed)); ok_all = False; continue
+            print("| %s | %s | missing results | | | | | | | | | | | | | |" % (scene, seed)); ok_all = False; ok_sim3 = False; continue
         rec = json.load(open(base + "_recall.json"))
         def group_recall(cls):
             t = sum(x["truth_boxes"] for x in rec.get("groups", []) if x["class"] == cls and "photo" in x["label"])
@@ -102,14 +108,40 @@ for scene, seeds in (("office", office), ("street", street)):
         ok_all = ok_all and c1 and c2 and c3 and c4
         f = lambda v: "%.4f" % v if v is not None else "-"
         yes = lambda c, v: ("%.2f " % v if v is not None else "") + ("yes" if c else "**no**")
-        print("| %s | %s | %s / %s | %s | %s | %s | %s | %s | %s %s | %s | %s | %s %s | %d / %d / %d of %d | %s / %s / %s |" % (
+        s3, s3g, s3n = full["ate_sim3_rmse_m"], gt["ate_sim3_rmse_m"], nodyn["ate_sim3_rmse_m"]
+        q1 = s3 / s3g if s3 is not None and s3g else None
+        q2 = s3 / s3n if s3 is not None and s3n else None
+        ok_sim3 = ok_sim3 and q1 is not None and q1 <= 1.5 and q2 is not None and q2 <= 0.3
+        sc = lambda v: "%.3f" % v["sim3_scale"] if v.get("sim3_scale") is not None else "-"
+        print("| %s | %s | %s / %s | %s | %s | %s | %s | %s | %s %s | %s | %s | %s %s | %d / %d / %d of %d | %s / %s / %s | %s, %s | %s / %s / %s |" % (
             scene, seed, group_recall("person"), group_recall("car"), f(a), f(ag), f(an),
             yes(c1, r1), yes(c2, r2), mvs, "yes" if c3 else "**no**", mls, ubs, sts,
             "yes" if c4 else "**no**", full["tracked"], gt["tracked"], nodyn["tracked"],
             full["frames"], f(full["ate_sim3_rmse_m"]), f(gt["ate_sim3_rmse_m"]),
-            f(nodyn["ate_sim3_rmse_m"])))
+            f(nodyn["ate_sim3_rmse_m"]), yes(q1 is not None and q1 <= 1.5, q1),
+            yes(q2 is not None and q2 <= 0.3, q2), sc(full), sc(gt), sc(nodyn)))
+        # The movers that matter (street): YOLOX's recall per object, and how much of the pose
+        # the movers are without removal (share of pose inliers on moving keypoints).
+        groups = {x["label"].split(" ")[0]: x for x in rec.get("groups", [])}
+        tn = nodyn["truth"] or {}
+        mi = tn.get("moving_kept_by_state", {}).get("pose_inlier", 0)
+        si = tn.get("static_kept_by_state", {}).get("pose_inlier", 0)
+        obj = lambda n: "%d/%d" % (groups[n]["found"], groups[n]["truth_boxes"]) if n in groups else "-"
+        sim3_rows.append("| %s | %s | %s | %s | %s | %s |" % (
+            scene, seed, obj("bus-crossing"), obj("car-lead"),
+            "%.1f%% (%d/%d)" % (100.0 * mi / (mi + si), mi, mi + si) if mi + si else "-",
+            "%.1f%%" % (100.0 * (t.get("moving_pose_inliers", 0)) / max(1, full["truth"]["static_kept_by_state"]["pose_inlier"] + t.get("moving_pose_inliers", 0)))))
 print()
 print("all criteria met" if ok_all else "NOT all criteria met")
+print("sim3 ratios met (yolox/gt <= 1.5, yolox/none <= 0.3)" if ok_sim3 else "sim3 ratios NOT all met")
+# The simulated network's depth has a constant scale error (configs: ~5 %), the same in every
+# variant: on the street's 100+ m it dominates the se3 ATE, which then compares three copies of
+# the same bias; sim3 takes the scale out and shows what the movers did to the trajectory.
+print()
+print("| scene | seed | YOLOX recall: bus crossing | lead car | pose inliers on movers, no removal | ... with YOLOX |")
+print("|---|---|---|---|---|---|")
+for row in sim3_rows:
+    print(row)
 # Why: what removed the static keypoints, what the moving keypoints that were not removed are,
 # and how many moving keypoints the pose used (with YOLOX-nano, and with no dynamic removal).
 print()

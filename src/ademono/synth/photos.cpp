@@ -97,7 +97,8 @@ ActorPhotos LoadActorPhotos(const fs::path& dir) {
                            static_cast<int>(std::lround(b.at(3).get<double>())));
         const bool person = class_id == 0 && score >= 0.5f && box.height >= 100;
         const bool car = class_id == 2 && score >= 0.5f && box.width >= 60;
-        if (person || car) candidates.push_back({file, i, class_id, score, box});
+        const bool bus = class_id == 5 && score >= 0.5f && box.width >= 60;
+        if (person || car || bus) candidates.push_back({file, i, class_id, score, box});
       }
     }
   } catch (const nlohmann::json::exception& e) {
@@ -119,7 +120,8 @@ ActorPhotos LoadActorPhotos(const fs::path& dir) {
     PhotoCutout cutout = CutOut(image, inside);
     cutout.source = c.file + "#" + std::to_string(c.index + 1);
     cutout.score = c.score;
-    (c.class_id == 0 ? photos.persons : photos.cars).push_back(std::move(cutout));
+    (c.class_id == 0 ? photos.persons : c.class_id == 2 ? photos.cars : photos.buses)
+        .push_back(std::move(cutout));
   }
   if (photos.persons.empty()) ThrowInputError(json_path, "no person box to cut out (score >= 0.5, >= 100 px tall)");
   if (photos.cars.empty()) ThrowInputError(json_path, "no car box to cut out (score >= 0.5, >= 60 px wide)");

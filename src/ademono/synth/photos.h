@@ -23,10 +23,12 @@ struct PhotoCutout {
 struct ActorPhotos {
   std::vector<PhotoCutout> persons;  // highest reference score first
   std::vector<PhotoCutout> cars;     // highest reference score first
+  std::vector<PhotoCutout> buses;    // highest reference score first; may be empty
 };
 
 // Reads `dir`/expected_detections.json and the photos it names. Persons need a score >= 0.5 and
-// a box at least 100 px tall, cars a score >= 0.5 and 60 px wide. Throws InputError (one line
+// a box at least 100 px tall, cars and buses a score >= 0.5 and 60 px wide (buses are optional:
+// the street's crossing vehicle falls back to a car). Throws InputError (one line
 // naming the file) when the folder, the JSON or a photo is missing or bad, or when no person or
 // no car qualifies. Deterministic (GrabCut's k-means is seeded).
 ActorPhotos LoadActorPhotos(const std::filesystem::path& dir);

@@ -1,8 +1,11 @@
 #include "ademono/synth/scenes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
 
 #include "ademono/synth/actors.h"
 #include "ademono/synth/photos.h"
@@ -222,6 +225,117 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   scene.world_from_cam = MakeCameraTrajectory(motion);
 }
 
+// The street's intersection (photos only), as on a KITTI drive: a city bus crosses the junction
+// from right to left at a steady 2.5-3.5 m/s (on the cross street, broadside to the camera), so
+// it is moving whenever it is in view, as its ground truth says; the camera's car brakes (2 s,
+// evenly) to a stop GAP m before the bus's line as the bus's front enters its lane, waits until
+// the bus has cleared the lane and pulls away (2 s) back to its speed. The stop starts at
+// 35-45 % of the drive. The lead car turns right into the cross street's near lane (3.5 m short
+// of the bus's line) before the camera stops, so the two never meet. Drives shorter than 8 s have
+// no stop (the bus crosses beyond the end of the drive at mid-drive).
+struct Crossing {
+  double speed = 10.0;                             // the camera's cruising speed, m/s
+  double ramp_s = 2.0;                             // braking and pulling away
+  double t_brake = 1e9, t_stop = 1e9, t_go = 1e9;  // s
+  double x_bus = 0.0;      // the bus's line (world x)
+  double t_mid = 0.0;      // s, when the bus's middle is on the camera's lane centre (y = -1.75)
+  double bus_speed = 3.0;  // m/s, along +y
+  double x_street() const { return x_bus - 1.75; }  // the cross street's middle
+  double x_turn() const { return x_bus - 3.5; }     // where the lead car turns
+  // Distance the camera has driven along x at time t.
+  double CameraX(double t) const {
+    if (t <= t_brake) return speed * t;
+    const double x_stop = speed * (t_brake + 0.5 * ramp_s);
+    if (t <= t_stop) {
+      const double tau = t - t_brake;
+      return speed * (t_brake + tau - tau * tau / (2 * ramp_s));
+    }
+    if (t <= t_go) return x_stop;
+    const double tau = t - t_go;
+    if (tau <= ramp_s) return x_stop + speed * tau * tau / (2 * ramp_s);
+    return x_stop + speed * (0.5 * ramp_s + tau - ramp_s);
+  }
+  // The bus's middle along y at time t.
+  double BusY(double t) const { return -1.75 + bus_speed * (t - t_mid); }
+};
+
+// The crossing vehicle's length: bus.jpg's bus is a minibus ("Un minibús 100% eléctrico" on its
+// side), 6.5 x 3.2 m; without a bus photo, a car 4.5 m long.
+double BusLength(bool bus) { return bus ? 6.5 : 4.5; }
+
+Crossing PlanCrossing(uint64_t seed, double camera_speed, double duration, double bus_length_m) {
+  Rng rng(seed);
+  Crossing crossing;
+  crossing.speed = camera_speed;
+  const double stop_at = rng.Uniform(0.35, 0.45) * duration;
+  const double gap = rng.Uniform(6.5, 8.0);
+  crossing.bus_speed = rng.Uniform(2.5, 3.5);
+  // The bus's front (half a length ahead of its middle) enters the lane (its right edge, y = -3.5)
+  // 0.0-0.5 s after the camera has stopped.
+  const double front_in = rng.Uniform(0.0, 0.5);
+  if (duration >= 8.0) {
+    crossing.t_stop = stop_at;
+    crossing.t_brake = stop_at - crossing.ramp_s;
+    crossing.x_bus = crossing.CameraX(stop_at) + gap;
+    crossing.t_mid = stop_at + front_in + (1.75 + 0.5 * bus_length_m) / crossing.bus_speed;
+    // Clear of the camera's lane (its rear 1 m past the lane's middle), then 0.3 s.
+    const double clear_y = -1.75 + 1.0 + 0.5 * bus_length_m;
+    crossing.t_go = crossing.t_mid + (clear_y + 1.75) / crossing.bus_speed + 0.3;
+  } else {
+    crossing.x_bus = camera_speed * duration + 2 * gap;
+    crossing.t_mid = 0.5 * duration;
+  }
+  return crossing;
+}
+
+// Adds the crossing bus and removes the buildings and parked cars in the cross street (16 m wide).
+void AddCrossingBus(Scene& scene, const ActorPhotos& photos, const Crossing& crossing) {
+  const double half_street = 8.0;
+  // Buildings (static structure above the ground) overlapping it, and every part of a parked car
+  // whose body is in it.
+  auto in_cross_street = [&](const Box& box) {
+    const Eigen::Vector3d c = box.world_from_box.translation();
+    if (std::abs(c.y()) < 5.0 || c.z() < 0.5) return false;  // road, sidewalks, lawns, wheels
+    const double half_x = box.object_id == 0 ? box.half_extents.x() : 2.5;
+    return std::abs(c.x() - crossing.x_street()) < half_street + half_x;
+  };
+  std::vector<int> removed_objects;
+  for (const Box& box : scene.static_boxes)
+    if (box.object_id != 0 && in_cross_street(box)) removed_objects.push_back(box.object_id);
+  std::vector<Box> kept;
+  kept.reserve(scene.static_boxes.size());
+  for (const Box& box : scene.static_boxes) {
+    const bool removed_object =
+        box.object_id != 0 && std::find(removed_objects.begin(), removed_objects.end(),
+                                        box.object_id) != removed_objects.end();
+    if (!removed_object && !(box.object_id == 0 && in_cross_street(box))) kept.push_back(box);
+  }
+  scene.static_boxes = std::move(kept);
+  const bool bus = !photos.buses.empty();
+  const PhotoCutout& cutout = bus ? photos.buses[0] : photos.cars[0];
+  // A bus photo is seldom broadside (bus.jpg's is seen from the front quarter, 1.6:1): stretched
+  // to the bus's side, and mirrored (the quad's u axis runs right to left as the camera sees it
+  // here) so its lettering reads. Measured on street seed 1 (docs/synth.md): YOLOX-nano finds this
+  // bus on 0.82 of the frames 20-120 that show it, a 10 m stretch on 0.49 and, unmirrored, 0.32.
+  PhotoCutout side = cutout;
+  const double length_m = BusLength(bus), height_m = bus ? 3.2 : 1.5;
+  const int width_px = static_cast<int>(std::lround(length_m / height_m * cutout.bgr.rows));
+  if (width_px > cutout.bgr.cols) {
+    cv::resize(cutout.bgr, side.bgr, cv::Size(width_px, cutout.bgr.rows), 0, 0, cv::INTER_LINEAR);
+    cv::resize(cutout.alpha, side.alpha, cv::Size(width_px, cutout.alpha.rows), 0, 0,
+               cv::INTER_NEAREST);
+  }
+  cv::flip(side.bgr, side.bgr, 1);
+  cv::flip(side.alpha, side.alpha, 1);
+  const int sprite = AddSprite(scene, side, height_m);
+  const int id = scene.AddObject(bus ? "bus-crossing" : "car-crossing", bus ? 5 : 2, true);
+  scene.objects[id - 1].appearance = cutout.source;
+  const double w = scene.sprites[sprite].width_m(), h = scene.sprites[sprite].height_m();
+  scene.actors.push_back([=](double t, std::vector<Box>& boxes) {
+    AppendSprite(At(crossing.x_bus, crossing.BusY(t), 0, M_PI / 2), 0.0, sprite, w, h, id, boxes);
+  });
+}
+
 void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& scene) {
   Rng rng(SubSeed(options.seed, 0x57EE7));
   TextureMaker textures(scene, SubSeed(options.seed, 0x7E88));
@@ -303,6 +417,9 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   // With photos, moving cars are photo cut-outs 1.5 m tall whose quad spans the road (seen
   // from behind or ahead); the draws for the box car are made anyway, so the rest of the scene
   // does not change.
+  // The intersection's plan (photos only; its own stream).
+  const Crossing crossing = PlanCrossing(SubSeed(options.seed, 0xB05), speed, duration,
+                                        BusLength(photos && !photos->buses.empty()));
   int photo_cars = 0;
   auto driving_car = [&](const Rigid3d& world_from_body_at_0, double car_speed,
                          const CarLook& look, int id) {
@@ -319,6 +436,34 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     // Same argument expressions as the box car had: the draws keep their (compiler's) order.
     scene.actors.push_back(driving_car(At(rng.Uniform(15, 22), -1.75, 0),
                                        speed * rng.Uniform(0.9, 1.05), car_look(), id));
+    if (photos) {
+      // With photos the lead car follows close, 8-12 m ahead at the camera's speed (the gap
+      // swinging slowly): static in the image, so only the detector can flag it, and large
+      // (~110 x 270 px at 10 m). At the intersection it turns right into the cross street
+      // (6 m/s along -y; its quad already faces the camera broadside). Own stream. Its photo is
+      // the second car cut-out (dog.jpg's pickup from ../shared/images): YOLOX-nano finds it on
+      // 41 of the first 50 frames of seed 1, street.png's taxi (the first) on 4.
+      Rng follow(SubSeed(options.seed, 0xF011));
+      const double gap = follow.Uniform(9.5, 10.5), swing = follow.Uniform(1.0, 1.5);
+      const double period = follow.Uniform(6.0, 10.0), phase = follow.Uniform(0, 2 * M_PI);
+      auto lead_x = [=](double t) {
+        return speed * t + gap + swing * std::sin(2 * M_PI * t / period + phase);
+      };
+      // lead_x rises monotonically (speed > swing's rate): bisect for the turn.
+      const double x_turn = crossing.x_turn();
+      double lo = 0.0, hi = duration + 10.0;
+      for (int i = 0; i < 60; ++i) ((lead_x(0.5 * (lo + hi)) < x_turn) ? lo : hi) = 0.5 * (lo + hi);
+      const double t_turn = lead_x(0.0) < x_turn ? lo : 0.0;
+      const PhotoCutout& cutout = photos->cars[std::min<size_t>(1, photos->cars.size() - 1)];
+      const int sprite = AddSprite(scene, cutout, 1.5);
+      scene.objects[id - 1].appearance = cutout.source;
+      const double w = scene.sprites[sprite].width_m(), h = scene.sprites[sprite].height_m();
+      scene.actors.back() = [=](double t, std::vector<Box>& boxes) {
+        const Eigen::Vector3d at = t < t_turn ? Eigen::Vector3d(lead_x(t), -1.75, 0)
+                                              : Eigen::Vector3d(x_turn, -1.75 - 6.0 * (t - t_turn), 0);
+        AppendSprite(At(at.x(), at.y(), 0), M_PI / 2, sprite, w, h, id, boxes);
+      };
+    }
   }
   const int oncoming = 2 + static_cast<int>(rng.Next() % 2);
   for (int i = 0; i < oncoming; ++i) {
@@ -373,6 +518,7 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
     AddTumblingBox(
         scene, "tumbling-cube", cube_path, 0.7, cube_half, Eigen::Vector3d(0.2, 1.0, 0.1), 2.0,
         decoy_textures.ForBox(TextureStyle::kCloth, cube_half, 0.01, RandomTint(decoy)));
+    AddCrossingBus(scene, *photos, crossing);
   }
 
   MotionSpec motion;
@@ -385,6 +531,12 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
   motion.jitter_rotation_rad = 0.002;
   motion.seed = SubSeed(options.seed, 0xCA4);
   scene.world_from_cam = MakeCameraTrajectory(motion);
+  if (photos) {
+    // The stop at the intersection: the same road, driven on the crossing's time table.
+    scene.world_from_cam = [drive = scene.world_from_cam, crossing](double t) {
+      return drive(crossing.CameraX(t) / crossing.speed);
+    };
+  }
 }
 
 // The street's loop: a ring road (the camera in the outer lane, counter-clockwise at about

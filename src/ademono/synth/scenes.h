@@ -28,8 +28,10 @@ struct SceneOptions {
   // Folder of actor photos (synth/photos.h), empty: procedural actors only. With photos the
   // walking persons, the street's moving cars and its pedestrian are photo cut-outs, and each
   // scene gains movers of no COCO class (a cart and a tumbling cube in the office, a crate and
-  // a tumbling cube in the street) that a detector should not box. Without, the scene is the
-  // same as before the option existed (byte-identical outputs).
+  // a tumbling cube in the street) that a detector should not box. The street's lead car then
+  // follows 8-12 m ahead until it turns off at an intersection, where the camera stops while a
+  // photo minibus pulls away across the road (docs/synth.md). Without, the scene is the same as
+  // before the option existed (byte-identical outputs).
   std::string actor_photos;
   // Throws std::invalid_argument naming the first bad field.
   void Check() const;
