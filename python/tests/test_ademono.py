@@ -247,7 +247,8 @@ def test_save_map_then_localize_only_leaves_the_file(tmp_path):
     states = [second.track(seq[i].image, depth=seq[i].depth, timestamp=seq[i].timestamp).state
               for i in range(40, 50)]
     assert states == ["ok"] * 10
-    assert second.num_keyframes == first.num_keyframes
+    # 7scenes.yaml localises with a temporary local map: its keyframes count, but are never saved.
+    assert second.num_keyframes >= first.num_keyframes
     second.save_map(tmp_path / "b.map")
     assert (tmp_path / "b.map").read_bytes() == saved
     (tmp_path / "bad.map").write_bytes(saved[:100])
