@@ -1,5 +1,6 @@
 #include "ademono/slam/system.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace ademono {
@@ -64,23 +65,20 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   result.quality = out.quality;
   result.geometric_dynamic = out.geometric_dynamic;
   result.geometric_culled = out.geometric_culled;
-  if (!out.match_state.empty()) {
-    // Back from the kept keypoints (the features) to all extracted keypoints.
-    result.match_state.assign(extracted.keypoints.size(), MatchState::kUnmatched);
-    for (size_t i = 0, k = 0; i < extracted.keypoints.size(); ++i) {
-      if (filtered.labels[i] != PointLabel::kKept) continue;
-      if (k < out.match_state.size()) result.match_state[i] = out.match_state[k];
-      ++k;
-    }
-  }
-  if (!out.created_points.empty()) {
-    std::vector<size_t> extracted_index;  // feature index -> extracted keypoint index
+  // Back from the kept keypoints (the features) to all extracted keypoints.
+  std::vector<size_t> extracted_index;  // feature index -> extracted keypoint index
+  if (!out.match_state.empty() || !out.created_points.empty()) {
     for (size_t i = 0; i < extracted.keypoints.size(); ++i) {
       if (filtered.labels[i] == PointLabel::kKept) extracted_index.push_back(i);
     }
-    for (const auto& [k, point] : out.created_points) {
-      if (k < extracted_index.size()) result.created_points.emplace_back(extracted_index[k], point);
-    }
+  }
+  if (!out.match_state.empty()) {
+    result.match_state.assign(extracted.keypoints.size(), MatchState::kUnmatched);
+    for (size_t k = 0; k < std::min(extracted_index.size(), out.match_state.size()); ++k)
+      result.match_state[extracted_index[k]] = out.match_state[k];
+  }
+  for (const auto& [k, point] : out.created_points) {
+    if (k < extracted_index.size()) result.created_points.emplace_back(extracted_index[k], point);
   }
   result.depth_scale = out.depth_scale;
   if (out.tracked) result.cam_from_world = out.cam_from_world;

@@ -236,19 +236,20 @@ void BuildOffice(const SceneOptions& options, const ActorPhotos* photos, Scene& 
 struct Crossing {
   double speed = 10.0;                             // the camera's cruising speed, m/s
   double ramp_s = 2.0;                             // braking and pulling away
-  double t_brake = 1e9, t_stop = 1e9, t_go = 1e9;  // s
+  double t_stop = 1e9, t_go = 1e9;                 // s
   double x_bus = 0.0;      // the bus's line (world x)
   double t_mid = 0.0;      // s, when the bus's middle is on the camera's lane centre (y = -1.75)
   double bus_speed = 3.0;  // m/s, along +y
+  double t_brake() const { return t_stop - ramp_s; }  // braking starts
   double x_street() const { return x_bus - 1.75; }  // the cross street's middle
   double x_turn() const { return x_bus - 3.5; }     // where the lead car turns
   // Distance the camera has driven along x at time t.
   double CameraX(double t) const {
-    if (t <= t_brake) return speed * t;
-    const double x_stop = speed * (t_brake + 0.5 * ramp_s);
+    if (t <= t_brake()) return speed * t;
+    const double x_stop = speed * (t_brake() + 0.5 * ramp_s);
     if (t <= t_stop) {
-      const double tau = t - t_brake;
-      return speed * (t_brake + tau - tau * tau / (2 * ramp_s));
+      const double tau = t - t_brake();
+      return speed * (t_brake() + tau - tau * tau / (2 * ramp_s));
     }
     if (t <= t_go) return x_stop;
     const double tau = t - t_go;
@@ -275,7 +276,6 @@ Crossing PlanCrossing(uint64_t seed, double camera_speed, double duration, doubl
   const double front_in = rng.Uniform(0.0, 0.5);
   if (duration >= 8.0) {
     crossing.t_stop = stop_at;
-    crossing.t_brake = stop_at - crossing.ramp_s;
     crossing.x_bus = crossing.CameraX(stop_at) + gap;
     crossing.t_mid = stop_at + front_in + (1.75 + 0.5 * bus_length_m) / crossing.bus_speed;
     // Clear of the camera's lane (its rear 1 m past the lane's middle), then 0.3 s.
