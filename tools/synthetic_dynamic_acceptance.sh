@@ -123,14 +123,16 @@ for scene, seeds in (("office", office), ("street", street)):
         # The movers that matter (street): YOLOX's recall per object, and how much of the pose
         # the movers are without removal (share of pose inliers on moving keypoints).
         groups = {x["label"].split(" ")[0]: x for x in rec.get("groups", [])}
-        tn = nodyn["truth"] or {}
-        mi = tn.get("moving_kept_by_state", {}).get("pose_inlier", 0)
-        si = tn.get("static_kept_by_state", {}).get("pose_inlier", 0)
+        def inlier_share(truth, counts):  # pose inliers on moving keypoints, of all pose inliers
+            mi = (truth or {}).get("moving_kept_by_state", {}).get("pose_inlier", 0)
+            si = (truth or {}).get("static_kept_by_state", {}).get("pose_inlier", 0)
+            if not mi + si:
+                return "-"
+            return "%.1f%%" % (100.0 * mi / (mi + si)) + (" (%d/%d)" % (mi, mi + si) if counts else "")
         obj = lambda n: "%d/%d" % (groups[n]["found"], groups[n]["truth_boxes"]) if n in groups else "-"
         sim3_rows.append("| %s | %s | %s | %s | %s | %s |" % (
-            scene, seed, obj("bus-crossing"), obj("car-lead"),
-            "%.1f%% (%d/%d)" % (100.0 * mi / (mi + si), mi, mi + si) if mi + si else "-",
-            "%.1f%%" % (100.0 * (t.get("moving_pose_inliers", 0)) / max(1, full["truth"]["static_kept_by_state"]["pose_inlier"] + t.get("moving_pose_inliers", 0)))))
+            scene, seed, obj("bus-crossing"), obj("car-lead"), inlier_share(nodyn["truth"], True),
+            inlier_share(t, False)))
 print()
 print("all criteria met" if ok_all else "NOT all criteria met")
 print("sim3 ratios met (yolox/gt <= 1.5, yolox/none <= 0.3)" if ok_sim3 else "sim3 ratios NOT all met")
