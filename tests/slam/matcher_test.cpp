@@ -49,6 +49,31 @@ TEST(MatcherTest, ProjectionSearchFindsTheSameDescriptorsUnderSmallMotion) {
   EXPECT_EQ(Matcher(0.9f, false).SearchByDescriptor(*kf, third, matches), 4);
 }
 
+// FindByProjection (the geometric test's look into the frame before a keyframe) returns the
+// matching keypoint within the window, also one that already has a map point, and writes nothing.
+TEST(MatcherTest, FindByProjectionReturnsTheKeypointWithinTheWindowOnly) {
+  Map map;
+  const auto f0 = TestFeatures({{100, 100}, {200, 150}, {400, 300}}, {1.5f, 2.0f, 2.5f}, 7);
+  Frame first(0, 0, 0.0, f0);
+  MapEveryKeypoint(map, first);
+  const auto f1 = TestFeatures({{103, 100}, {200, 154}, {400, 300}}, {1.5f, 2.0f, 2.5f}, 7);
+  Frame second(1, 1, 1 / 30.0, f1);
+  second.cam_from_world = Rigid3d::Identity();
+  second.map_points[2] = first.map_points[2];
+  const Matcher matcher(0.8f, false);
+  for (size_t i = 0; i < 3; ++i) {
+    ProjectionPrediction prediction;
+    ASSERT_TRUE(second.InFrustum(*first.map_points[i], 0.5f, &prediction));
+    // Shifted 3 / 4 / 0 px: a 6 px window finds each, a 2 px window only the one in place.
+    EXPECT_EQ(matcher.FindByProjection(second, *first.map_points[i], prediction, 6.f),
+              static_cast<int>(i));
+    EXPECT_EQ(matcher.FindByProjection(second, *first.map_points[i], prediction, 2.f),
+              i == 2 ? 2 : -1);
+  }
+  EXPECT_EQ(second.map_points[0], nullptr);
+  EXPECT_EQ(second.map_points[2], first.map_points[2]);
+}
+
 // The rotation check (feature/matching.h's RotationHistogram) drops a match whose keypoint turned
 // against all the others, and only with check_orientation.
 TEST(MatcherTest, RotationCheckDropsTheMatchThatTurnedAgainstTheOthers) {

@@ -111,6 +111,31 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
   return matches;
 }
 
+int Matcher::FindByProjection(const Frame& frame, const MapPoint& point,
+                              const ProjectionPrediction& prediction, float radius) const {
+  const FrameFeatures& f = frame.F();
+  const int level = prediction.level;
+  const float r = radius * f.pyramid->scale_factors[level];
+  int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
+  int best_idx = -1;
+  for (size_t idx : f.FeaturesInArea(prediction.u, prediction.v, r, level - 1, level)) {
+    const int d = DescriptorDistance(point.descriptor, f.descriptors.row(static_cast<int>(idx)));
+    if (d < best_dist) {
+      best_dist2 = best_dist;
+      best_level2 = best_level;
+      best_dist = d;
+      best_level = f.keypoints_un[idx].octave;
+      best_idx = static_cast<int>(idx);
+    } else if (d < best_dist2) {
+      best_dist2 = d;
+      best_level2 = f.keypoints_un[idx].octave;
+    }
+  }
+  if (best_dist > kOrbDistanceHigh) return -1;
+  if (best_level == best_level2 && best_dist > nn_ratio_ * best_dist2) return -1;
+  return best_idx;
+}
+
 int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius,
                                 int max_distance) const {
   const FrameFeatures& f = frame.F();

@@ -28,6 +28,13 @@ class Matcher {
   int SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<MapPoint>>& points,
                          const std::vector<ProjectionPrediction>& predictions, float radius) const;
 
+  // The keypoint of `frame` that best matches `point` within `radius` (px at the predicted level)
+  // of its prediction, on the predicted level or the one below, passing the distance threshold
+  // and the ratio test; -1 if none. Keypoints already matched are candidates too; nothing is
+  // written (the geometric test judges a new point in the frame before its keyframe).
+  int FindByProjection(const Frame& frame, const MapPoint& point,
+                       const ProjectionPrediction& prediction, float radius) const;
+
   // Relocalisation: map points of `keyframe` not yet in `found` projected into `frame`.
   int SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius,
                          int max_distance) const;

@@ -24,21 +24,29 @@ const OptionsTable<StaticTestParams>& StaticTestParams::Table() {
           .Add("static_parallax_sigmas", &P::parallax_sigmas, Range::AtLeast(0))
           .Add("static_point_sigma_relative", &P::point_sigma_relative, Range::AtLeast(0))
           .Add("static_point_sigma_per_metre", &P::point_sigma_per_metre, Range::AtLeast(0))
-          .Add("static_depth_at_reference", &P::depth_at_reference);
+          .Add("static_point_depth_sigmas", &P::point_depth_sigmas, Range::Above(0))
+          .Add("static_point_depth_dynamic_sigmas", &P::point_depth_dynamic_sigmas,
+               Range::Above(0))
+          .Add("static_depth_at_reference", &P::depth_at_reference)
+          .Add("static_confirm_in_last_frame", &P::confirm_in_last_frame);
   return table;
 }
 
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
                                 const StaticTestParams& params, double depth_relative_sigma,
-                                double residual_allowance_px) {
+                                double residual_allowance_px, double point_relative_sigma) {
   if (!std::isfinite(residual_px)) return StaticEvidence::kDynamic;
   const double allowance =
       std::isfinite(residual_allowance_px) ? std::max(residual_allowance_px, 0.0) : 0.0;
   const bool depth_known = depth_relative_error && std::isfinite(*depth_relative_error);
   const double sigma = std::isfinite(depth_relative_sigma) ? std::max(depth_relative_sigma, 0.0) : 0.0;
-  const double static_band = std::max(params.depth_relative, params.depth_sigmas * sigma);
+  const double noise =
+      std::isfinite(point_relative_sigma) ? std::max(point_relative_sigma, 0.0) : 0.0;
+  const double static_band = std::max(
+      {params.depth_relative, params.depth_sigmas * sigma, params.point_depth_sigmas * noise});
   const double dynamic_band =
-      std::max(params.depth_dynamic_relative, params.depth_dynamic_sigmas * sigma);
+      std::max({params.depth_dynamic_relative, params.depth_dynamic_sigmas * sigma,
+                params.point_depth_dynamic_sigmas * noise});
   if (residual_px > params.residual_dynamic_px + allowance ||
       (depth_known && *depth_relative_error > dynamic_band))
     return StaticEvidence::kDynamic;
@@ -61,6 +69,19 @@ double PointDepthSigma(double distance, const StaticTestParams& params,
   const double configured = params.point_sigma_relative + params.point_sigma_per_metre * distance;
   const double model = std::isfinite(model_relative_sigma) ? model_relative_sigma : 0.0;
   return std::max({configured, model, 0.0});
+}
+
+double PointDepthDisagreementSigma(double z_measured, double reference_distance,
+                                   const StaticTestParams& params) {
+  if (!(z_measured > 0) || !std::isfinite(z_measured)) return 0.0;
+  const bool has_reference = reference_distance > 0 && std::isfinite(reference_distance);
+  const double z_map = has_reference ? reference_distance : z_measured;
+  auto sigma_at = [&](double z) {
+    return z * (params.point_sigma_relative + params.point_sigma_per_metre * z);
+  };
+  double scale = z_measured;
+  if (params.depth_at_reference && has_reference) scale = std::max(scale, reference_distance);
+  return std::hypot(sigma_at(z_map), sigma_at(z_measured)) / scale;
 }
 
 double ParallaxShiftPx(const Eigen::Vector3d& point_world, const Eigen::Vector3d& ray_origin_world,

@@ -41,12 +41,23 @@ struct StaticTestParams {
   double parallax_sigmas = 3.0;
   double point_sigma_relative = 0.0;
   double point_sigma_per_metre = 0.0;
+  // The same sigma in the depth comparison: the map's depth (made at the reference distance) and
+  // the measured one each carry it, so the static and motion bands widen to these multiples of
+  // their combined sigma when that is wider (a depth without an error model: 2 and 4 sigmas, the
+  // usual bounds of agreement and of a clear outlier; with 1 % + 0.1 %/m at 30 m the two depths
+  // differ by more than the fixed 5 % band in two comparisons of five).
+  double point_depth_sigmas = 2.0;
+  double point_depth_dynamic_sigmas = 4.0;
   // The map's depth of a point carries the error of the depth that made it, a fraction of the
   // distance it was measured at: approached at speed (made at 30 m, seen at 20 m), that is a
   // larger fraction of the depth measured now. true: the depth bands are relative to the larger
   // of the measured depth and the point's distance from its reference keyframe; false: to the
   // measured depth alone.
   bool depth_at_reference = true;
+  // A new keyframe point is judged at once in the frame before the keyframe (found there by
+  // projection), whose pose was computed without it: agreeing there admits it now instead of at
+  // the next frame that matches it. false: only later frames judge it.
+  bool confirm_in_last_frame = true;
 
   // Its keys of the flat `tracking:` node (static_prior, ...; TrackingOptions holds them).
   static const OptionsTable<StaticTestParams>& Table();
@@ -62,9 +73,13 @@ enum class StaticEvidence { kNone, kStatic, kDynamic };
 // sensor, judged by the fixed bands alone).
 // `residual_allowance_px` widens both residual thresholds (the point's own position
 // uncertainty seen from this frame, ParallaxShiftPx times parallax_sigmas).
+// `point_relative_sigma` is the combined sigma of the two compared depths from the configured
+// point sigma (PointDepthDisagreementSigma), judged at point_depth_sigmas and
+// point_depth_dynamic_sigmas.
 StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_relative_error,
                                 const StaticTestParams& params, double depth_relative_sigma = 0.0,
-                                double residual_allowance_px = 0.0);
+                                double residual_allowance_px = 0.0,
+                                double point_relative_sigma = 0.0);
 
 // The disagreement |z_map - z_measured| the depth bands judge, relative to z_measured, or with
 // `depth_at_reference` to the larger of z_measured and `reference_distance` (the point's distance
@@ -77,6 +92,13 @@ double RelativeDepthDisagreement(double z_map, double z_measured, double referen
 // (`model_relative_sigma`, 0 without one).
 double PointDepthSigma(double distance, const StaticTestParams& params,
                        double model_relative_sigma = 0.0);
+
+// The sigma of RelativeDepthDisagreement from the configured point sigma alone (not an error
+// model's): the map's depth measured at `reference_distance` and the depth `z_measured`, each
+// with sigma_z = z (point_sigma_relative + point_sigma_per_metre z), combined in quadrature and
+// relative to the same scale RelativeDepthDisagreement divides by. 0 when no sigma is configured.
+double PointDepthDisagreementSigma(double z_measured, double reference_distance,
+                                   const StaticTestParams& params);
 
 // How far (pixels, pinhole with focal lengths fx, fy) the projection into `cam_from_world` of
 // `point_world` moves when the point slides along the ray from `ray_origin_world` (the camera

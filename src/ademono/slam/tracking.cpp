@@ -640,8 +640,6 @@ bool Tracking::UsableForPose(const MapPoint& point) const {
 }
 
 int Tracking::JudgeStaticness(Frame& frame) {
-  const FrameFeatures& f = frame.F();
-  const StaticTestParams& params = options_.tracking.static_params;
   // A point at the floor has been seen moving again and again: out of the map, so that local BA
   // and matching stop meeting it.
   constexpr double kCullProbability = 0.05;
@@ -650,40 +648,7 @@ int Tracking::JudgeStaticness(Frame& frame) {
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     auto& p = frame.map_points[i];
     if (!p || p->bad) continue;
-    const Eigen::Vector3d cam = *frame.cam_from_world * p->position;
-    double residual = std::numeric_limits<double>::infinity();
-    std::optional<double> depth_error;
-    double depth_sigma = 0.0;
-    double allowance = 0.0;
-    if (cam.z() > 0) {
-      const cv::KeyPoint& kp = f.keypoints_un[i];
-      const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
-      const double v = f.intrinsics.fy * cam.y() / cam.z() + f.intrinsics.cy;
-      // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
-      const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
-      residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
-      const KeyFrame* ref = p->reference;
-      const bool has_ref = ref != nullptr && !ref->bad;
-      const Eigen::Vector3d origin = has_ref ? ref->CameraCenter() : Eigen::Vector3d::Zero();
-      const double distance = has_ref ? (p->position - origin).norm() : 0.0;
-      if (f.depth[i] > 0) {
-        depth_error = RelativeDepthDisagreement(cam.z(), f.depth[i], distance, params);
-        if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
-      }
-      // The point's own uncertainty along the ray that measured it, seen from here: its depth's
-      // sigma as a shift in the image.
-      if (params.parallax_sigmas > 0 && has_ref) {
-        const double sigma = PointDepthSigma(
-            distance, params, f.DepthIsPrior() ? f.depth_error.RelativeSigma(distance) : 0.0);
-        if (sigma > 0)
-          allowance = params.parallax_sigmas *
-                      ParallaxShiftPx(p->position, origin, *frame.cam_from_world,
-                                      f.intrinsics.fx, f.intrinsics.fy, sigma) /
-                      level_scale;
-      }
-    }
-    const StaticEvidence evidence =
-        JudgeObservation(residual, depth_error, params, depth_sigma, allowance);
+    const StaticEvidence evidence = JudgeObservationOf(frame, *p, i);
     if (evidence == StaticEvidence::kDynamic) ++p->motion_verdicts;
     p->static_probability = UpdateStaticProbability(p->static_probability, evidence);
     if (UsableForPose(*p)) {
@@ -703,6 +668,70 @@ int Tracking::JudgeStaticness(Frame& frame) {
   for (MapPoint* p : cull) map_.ErasePoint(p);
   geometric_culled_ += static_cast<int>(cull.size());
   return dynamic;
+}
+
+StaticEvidence Tracking::JudgeObservationOf(const Frame& frame, const MapPoint& point,
+                                            size_t i) const {
+  const FrameFeatures& f = frame.F();
+  const StaticTestParams& params = options_.tracking.static_params;
+  const Eigen::Vector3d cam = *frame.cam_from_world * point.position;
+  double residual = std::numeric_limits<double>::infinity();
+  std::optional<double> depth_error;
+  double depth_sigma = 0.0;
+  double allowance = 0.0;
+  double point_sigma = 0.0;
+  if (cam.z() > 0) {
+    const cv::KeyPoint& kp = f.keypoints_un[i];
+    const double u = f.intrinsics.fx * cam.x() / cam.z() + f.intrinsics.cx;
+    const double v = f.intrinsics.fy * cam.y() / cam.z() + f.intrinsics.cy;
+    // In level-0 pixels of the keypoint's own level (coarse levels are that much less exact).
+    const double level_scale = f.pyramid->scale_factors[static_cast<size_t>(kp.octave)];
+    residual = std::hypot(u - kp.pt.x, v - kp.pt.y) / level_scale;
+    const KeyFrame* ref = point.reference;
+    const bool has_ref = ref != nullptr && !ref->bad;
+    const Eigen::Vector3d origin = has_ref ? ref->CameraCenter() : Eigen::Vector3d::Zero();
+    const double distance = has_ref ? (point.position - origin).norm() : 0.0;
+    if (f.depth[i] > 0) {
+      depth_error = RelativeDepthDisagreement(cam.z(), f.depth[i], distance, params);
+      point_sigma = PointDepthDisagreementSigma(f.depth[i], distance, params);
+      if (f.DepthIsPrior()) depth_sigma = f.depth_error.RelativeSigma(f.depth[i]);
+    }
+    // The point's own uncertainty along the ray that measured it, seen from here: its depth's
+    // sigma as a shift in the image.
+    if (params.parallax_sigmas > 0 && has_ref) {
+      const double sigma = PointDepthSigma(
+          distance, params, f.DepthIsPrior() ? f.depth_error.RelativeSigma(distance) : 0.0);
+      if (sigma > 0)
+        allowance = params.parallax_sigmas *
+                    ParallaxShiftPx(point.position, origin, *frame.cam_from_world,
+                                    f.intrinsics.fx, f.intrinsics.fy, sigma) /
+                    level_scale;
+    }
+  }
+  return JudgeObservation(residual, depth_error, params, depth_sigma, allowance, point_sigma);
+}
+
+void Tracking::JudgeInLastFrame(const std::vector<MapPoint*>& points) {
+  const StaticTestParams& params = options_.tracking.static_params;
+  if (!options_.tracking.static_test || !params.confirm_in_last_frame || !last_frame_ ||
+      !last_frame_->cam_from_world)
+    return;
+  const Frame& last = *last_frame_;
+  const Matcher matcher(0.8f, false);
+  for (MapPoint* p : points) {
+    ProjectionPrediction prediction;
+    if (!last.InFrustum(*p, 0.5f, &prediction)) continue;
+    // The window reaches the motion band; only agreement counts: in repetitive texture (road,
+    // facades) the best match a few pixels off is often another keypoint, and its "motion" would
+    // condemn static points. Motion is left to the frames after the keyframe.
+    const int j = matcher.FindByProjection(last, *p, prediction,
+                                           static_cast<float>(params.residual_dynamic_px));
+    if (j < 0 ||
+        JudgeObservationOf(last, *p, static_cast<size_t>(j)) != StaticEvidence::kStatic)
+      continue;
+    p->static_probability = UpdateStaticProbability(p->static_probability, StaticEvidence::kStatic);
+    if (UsableForPose(*p)) p->admitted = true;
+  }
 }
 
 bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
@@ -786,6 +815,7 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
   std::sort(by_depth.begin(), by_depth.end());
   const Rigid3d world_from_cam = frame.cam_from_world->inverse();
   int considered = 0;
+  std::vector<MapPoint*> new_points;
   for (const auto& [z, i] : by_depth) {
     if (!kf->map_points[i]) {
       // Boxes raise the prior of motion; geometry decides.
@@ -794,11 +824,15 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
                            boxed ? options_.tracking.static_params.box_prior
                                  : options_.tracking.static_params.prior);
       frame.outlier[i] = false;
+      new_points.push_back(frame.map_points[i].get());
       if (created != nullptr) created->emplace_back(i, frame.map_points[i]);
     }
     ++considered;
     if (z > f.close_depth && considered > options_.tracking.new_keyframe_min_points) break;
   }
+  // A new point must agree with one more frame, at a pose computed without it, before it is used.
+  // The frame before the keyframe is such a frame, and it is already here.
+  JudgeInLastFrame(new_points);
   reference_keyframe_ = kf.get();
   frame.reference_keyframe = kf.get();
   last_keyframe_frame_id_ = frame.id;

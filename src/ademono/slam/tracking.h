@@ -139,6 +139,11 @@ class Tracking {
   // the ones below the threshold as outliers and culls the ones at the floor. Returns how many
   // are below the threshold.
   int JudgeStaticness(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // The geometric test's verdict on `point` seen as keypoint i of `frame`, at the frame's pose.
+  StaticEvidence JudgeObservationOf(const Frame& frame, const MapPoint& point, size_t i) const
+      ADEMONO_REQUIRES(map_.mutex);
+  // New keyframe points judged in the frame before the keyframe (static_confirm_in_last_frame).
+  void JudgeInLastFrame(const std::vector<MapPoint*>& points) ADEMONO_REQUIRES(map_.mutex);
   // A map point from keypoint i's depth, observed by `keyframe` (made from `frame`).
   void CreatePointFromDepth(Frame& frame, KeyFrame& keyframe, const Rigid3d& world_from_cam,
                             size_t i, double static_probability) ADEMONO_REQUIRES(map_.mutex);
