@@ -75,6 +75,7 @@ const OptionsTable<FilterOptions>& FilterOptions::Table() {
           .AddFlat(&F::dynamic, DynamicParams::Table())
           .Add("z_th_m", &F::z_th_m, Range::Above(0))
           .Add("drop_probability", &F::drop_probability, Range::Closed(0, 1))
+          .Add("distant_keep_bearing", &F::distant_keep_bearing)
           .Add("seed", &F::seed);
   return table;
 }

@@ -55,6 +55,9 @@ struct FilterOptions {
   // Distant filter.
   double z_th_m = 30.0;
   double drop_probability = 0.5;
+  // false (the paper's rule): a drawn far point is removed. true: only its depth is dropped; the
+  // keypoint still matches map points as a bearing (rotation) but makes no new point.
+  bool distant_keep_bearing = false;
   uint64_t seed = 42;
 
   void Check() const;                                     // throws std::invalid_argument
@@ -65,6 +68,13 @@ struct FilterOptions {
 };
 
 // What the filter needs of the previous frame for the two-stage dynamic test.
+// Whether a keypoint with this label goes on to tracking: kept ones, and with
+// `distant_keep_bearing` the distant-dropped ones (without their depth).
+inline bool FeedsTracking(PointLabel label, const FilterOptions& options) {
+  return label == PointLabel::kKept ||
+         (options.distant_keep_bearing && label == PointLabel::kDistantDropped);
+}
+
 struct PreviousFrameFeatures {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;

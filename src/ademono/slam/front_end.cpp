@@ -65,11 +65,11 @@ FilteredFrame FrontEnd::Filter(const ExtractedFrame& extracted,
   cv::Mat kept_descriptors;
   std::vector<float> kept_depths;
   for (size_t i = 0; i < keypoints.size(); ++i) {
-    if (out.labels[i] != PointLabel::kKept) continue;
+    if (!FeedsTracking(out.labels[i], options_.filter)) continue;
     kept_keypoints.push_back(keypoints[i]);
     kept_descriptors.push_back(extracted.descriptors.row(static_cast<int>(i)));
-    kept_depths.push_back(depths[i]);
-    if (depths[i] > 0) ++out.num_with_depth;
+    kept_depths.push_back(out.labels[i] == PointLabel::kKept ? depths[i] : 0.f);
+    if (kept_depths.back() > 0) ++out.num_with_depth;
   }
   out.num_kept = static_cast<int>(kept_keypoints.size());
   out.filter_ms = MsSince(start);

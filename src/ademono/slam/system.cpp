@@ -69,7 +69,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   std::vector<size_t> extracted_index;  // feature index -> extracted keypoint index
   if (!out.match_state.empty() || !out.created_points.empty()) {
     for (size_t i = 0; i < extracted.keypoints.size(); ++i) {
-      if (filtered.labels[i] == PointLabel::kKept) extracted_index.push_back(i);
+      if (FeedsTracking(filtered.labels[i], options_.filter)) extracted_index.push_back(i);
     }
   }
   if (!out.match_state.empty()) {
