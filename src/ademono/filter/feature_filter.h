@@ -67,7 +67,6 @@ struct FilterOptions {
   bool operator==(const FilterOptions&) const = default;
 };
 
-// What the filter needs of the previous frame for the two-stage dynamic test.
 // Whether a keypoint with this label goes on to tracking: kept ones, and with
 // `distant_keep_bearing` the distant-dropped ones (without their depth).
 inline bool FeedsTracking(PointLabel label, const FilterOptions& options) {
@@ -75,6 +74,7 @@ inline bool FeedsTracking(PointLabel label, const FilterOptions& options) {
          (options.distant_keep_bearing && label == PointLabel::kDistantDropped);
 }
 
+// What the filter needs of the previous frame for the two-stage dynamic test.
 struct PreviousFrameFeatures {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;

@@ -7,6 +7,39 @@
 #include "ademono/feature/orb_extractor.h"
 
 namespace ademono {
+namespace {
+
+// The keypoint within `r` px of the prediction, on its level or the one below, whose descriptor is
+// nearest to `descriptor` (candidates for which `skip` is true left out), if it is within
+// kOrbDistanceHigh and, when the runner-up is on the same level, clearly better than it (ratio
+// `nn_ratio`); -1 otherwise.
+template <typename Skip>
+int BestInArea(const FrameFeatures& f, const cv::Mat& descriptor,
+               const ProjectionPrediction& prediction, float r, float nn_ratio, Skip skip) {
+  const int level = prediction.level;
+  int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
+  int best_idx = -1;
+  for (size_t idx : f.FeaturesInArea(prediction.u, prediction.v, r, level - 1, level)) {
+    if (skip(idx)) continue;
+    const int d = DescriptorDistance(descriptor, f.descriptors.row(static_cast<int>(idx)));
+    if (d < best_dist) {
+      best_dist2 = best_dist;
+      best_level2 = best_level;
+      best_dist = d;
+      best_level = f.keypoints_un[idx].octave;
+      best_idx = static_cast<int>(idx);
+    } else if (d < best_dist2) {
+      best_dist2 = d;
+      best_level2 = f.keypoints_un[idx].octave;
+    }
+  }
+  if (best_dist > kOrbDistanceHigh) return -1;
+  if (best_level == best_level2 && best_dist > nn_ratio * best_dist2) return -1;
+  return best_idx;
+}
+
+}  // namespace
+
 int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius) const {
   const FrameFeatures& cf = current.F();
   const FrameFeatures& lf = last.F();
@@ -81,32 +114,14 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
     const ProjectionPrediction& pred = predictions[k];
     const int level = pred.level;
     const float r = radius * RadiusByViewingCos(pred.view_cos) * f.pyramid->scale_factors[level];
-    const std::vector<size_t> candidates = f.FeaturesInArea(pred.u, pred.v, r, level - 1, level);
-    int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
-    size_t best_idx = 0;
-    for (size_t idx : candidates) {
-      if (frame.map_points[idx] && frame.map_points[idx]->NumObservations() > 0) continue;
-      if (f.u_right[idx] > 0 &&
-          std::abs(pred.u_right - f.u_right[idx]) > r * f.pyramid->scale_factors[level]) {
-        continue;
-      }
-      const int d = DescriptorDistance(point->descriptor, f.descriptors.row(static_cast<int>(idx)));
-      if (d < best_dist) {
-        best_dist2 = best_dist;
-        best_level2 = best_level;
-        best_dist = d;
-        best_level = f.keypoints_un[idx].octave;
-        best_idx = idx;
-      } else if (d < best_dist2) {
-        best_dist2 = d;
-        best_level2 = f.keypoints_un[idx].octave;
-      }
-    }
-    if (best_dist <= kOrbDistanceHigh) {
-      if (best_level == best_level2 && best_dist > nn_ratio_ * best_dist2) continue;
-      frame.map_points[best_idx] = point;
-      ++matches;
-    }
+    const int best = BestInArea(f, point->descriptor, pred, r, nn_ratio_, [&](size_t idx) {
+      return (frame.map_points[idx] && frame.map_points[idx]->NumObservations() > 0) ||
+             (f.u_right[idx] > 0 &&
+              std::abs(pred.u_right - f.u_right[idx]) > r * f.pyramid->scale_factors[level]);
+    });
+    if (best < 0) continue;
+    frame.map_points[static_cast<size_t>(best)] = point;
+    ++matches;
   }
   return matches;
 }
@@ -114,26 +129,9 @@ int Matcher::SearchByProjection(Frame& frame, const std::vector<std::shared_ptr<
 int Matcher::FindByProjection(const Frame& frame, const MapPoint& point,
                               const ProjectionPrediction& prediction, float radius) const {
   const FrameFeatures& f = frame.F();
-  const int level = prediction.level;
-  const float r = radius * f.pyramid->scale_factors[level];
-  int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
-  int best_idx = -1;
-  for (size_t idx : f.FeaturesInArea(prediction.u, prediction.v, r, level - 1, level)) {
-    const int d = DescriptorDistance(point.descriptor, f.descriptors.row(static_cast<int>(idx)));
-    if (d < best_dist) {
-      best_dist2 = best_dist;
-      best_level2 = best_level;
-      best_dist = d;
-      best_level = f.keypoints_un[idx].octave;
-      best_idx = static_cast<int>(idx);
-    } else if (d < best_dist2) {
-      best_dist2 = d;
-      best_level2 = f.keypoints_un[idx].octave;
-    }
-  }
-  if (best_dist > kOrbDistanceHigh) return -1;
-  if (best_level == best_level2 && best_dist > nn_ratio_ * best_dist2) return -1;
-  return best_idx;
+  return BestInArea(f, point.descriptor, prediction,
+                    radius * f.pyramid->scale_factors[prediction.level], nn_ratio_,
+                    [](size_t) { return false; });
 }
 
 int Matcher::SearchByProjection(Frame& frame, const KeyFrame& keyframe, float radius,
