@@ -4,18 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ademono/core/statistics.h"
+
 namespace ademono {
-namespace {
-
-double Median(std::vector<double> values) {
-  const size_t n = values.size();
-  std::nth_element(values.begin(), values.begin() + n / 2, values.end());
-  const double upper = values[n / 2];
-  if (n % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + n / 2));
-}
-
-}  // namespace
 
 void DepthScaleOptions::Check() const {
   if (min_points < 1) throw std::invalid_argument("depth scale: min_points must be >= 1");

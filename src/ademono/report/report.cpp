@@ -12,6 +12,7 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
+#include "ademono/core/statistics.h"
 #include "ademono/core/yaml_util.h"
 #include "ademono/report/web_assets.h"
 
@@ -70,13 +71,6 @@ std::string Base64(const uint8_t* data, size_t size) {
 
 // Rounded so the embedded JSON stays small (millimetres, microseconds are below what a plot shows).
 double Round(double v, double step) { return std::round(v / step) * step; }
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 json RequireKey(const json& object, const char* key, const fs::path& file) {
   if (!object.is_object() || !object.contains(key)) {

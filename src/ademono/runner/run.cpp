@@ -3,6 +3,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "ademono/core/statistics.h"
 #include "ademono/eval/trajectory_eval.h"
 
 namespace ademono {
@@ -198,7 +199,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   report.map_points = system.NumMapPoints();
   report.trajectory = system.FrameTrajectory();
   report.keyframe_trajectory = system.KeyFrameTrajectory();
-  if (options.system.depth.IsPrior()) {
+  report.ground_heights = system.GroundHeights();
+  if (options.system.depth.IsPrior() || options.system.depth.GroundScale()) {
     std::map<size_t, double> scales;
     for (const auto& [index, scale] : system.DepthScales()) scales[index] = scale;
     for (FrameReport& f : report.per_frame) {
@@ -293,6 +295,14 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     j["depth_scale"] = {{"median", Percentile(depth_scales, 0.5)},
                         {"p10", Percentile(depth_scales, 0.1)},
                         {"p90", Percentile(depth_scales, 0.9)}};
+  }
+  if (o.depth.GroundScale()) {
+    // The map's scale from the known camera height: how often the ground was found and the
+    // camera's median height above it in the final map (camera_height when it worked; the
+    // scale it gave the depths is depth_scale).
+    j["ground_scale"] = {{"camera_height", o.depth.camera_height},
+                         {"estimates", report.ground_heights.size()},
+                         {"map_height", Median(report.ground_heights)}};
   }
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& f : report.per_frame) {

@@ -255,6 +255,11 @@ size_t BackEnd::NumMapPoints() const {
 
 int BackEnd::NumLost() const { return tracking_.NumLost(); }
 
+std::vector<double> BackEnd::GroundHeights() const {
+  MutexLock lock(map_.mutex);
+  return tracking_.GroundHeights();
+}
+
 int BackEnd::NumTracked() const {
   int n = 0;
   for (const FrameRecord& r : tracking_.Records()) n += r.tracked ? 1 : 0;

@@ -78,6 +78,8 @@ class BackEnd {
   size_t NumKeyFrames() const;
   size_t NumMapPoints() const;
   int NumLost() const;
+  // depth.camera_height: the camera heights measured above the ground (Tracking::GroundHeights).
+  std::vector<double> GroundHeights() const;
   int NumTracked() const;
 
  private:

@@ -164,7 +164,8 @@ void Map::Rescale(double factor) {
   auto rescale_keyframe = [factor](KeyFrame& kf) {
     kf.cam_from_world.translation() *= factor;
     kf.cam_from_parent.translation() *= factor;
-    if (kf.F().DepthIsPrior()) kf.features = RescaleDepth(kf.F(), static_cast<float>(factor));
+    // The keyframe's depths too: local BA's depth residuals would pull the map back.
+    kf.features = RescaleDepth(kf.F(), static_cast<float>(factor));
   };
   for (auto& [id, kf] : keyframes_) rescale_keyframe(*kf);
   for (auto& kf : graveyard_) rescale_keyframe(*kf);

@@ -33,7 +33,18 @@ const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
                                 .Add("anchor_scale", &D::anchor_scale)
                                 .Add("anchor_tolerance", &D::anchor_tolerance, Range::AtLeast(0))
                                 .Add("edge_relative_slope", &D::edge_relative_slope,
-                                     Range::AtLeast(0));
+                                     Range::AtLeast(0))
+                                .Add("camera_height", &D::camera_height, Range::AtLeast(0))
+                                .Add("ground_max_depth", &D::ground_max_depth, Range::Above(0))
+                                .Add("ground_max_lateral", &D::ground_max_lateral,
+                                     Range::Above(0))
+                                .Add("ground_max_tilt_deg", &D::ground_max_tilt_deg,
+                                     Range::OpenClosed(0, 80))
+                                .Add("ground_inlier_ratio", &D::ground_inlier_ratio,
+                                     Range::Above(0))
+                                .Add("ground_min_inliers", &D::ground_min_inliers,
+                                     Range::AtLeast(3))
+                                .Add("ground_tolerance", &D::ground_tolerance, Range::AtLeast(0));
   return table;
 }
 

@@ -61,6 +61,25 @@ struct FrameDepthOptions {
   // edge_radius pixels sits on a blurred object boundary and gets no depth (0 disables). Replaces
   // the hole / range test of sensor depth when the error model is on.
   double edge_relative_slope = 0.0;
+  // Known camera height above a flat ground (a vehicle's mounting height; KITTI 1.65 m), 0: off.
+  // The ground plane is fitted to the keypoints below the horizon (optimize/ground_plane.h) at
+  // initialisation and at every keyframe, and the map's scale is anchored to camera_height over
+  // the median of the measured heights instead of to the network's own mean: a network's
+  // constant scale bias becomes observable. Not with a loaded map (it keeps its scale).
+  double camera_height = 0.0;
+  // The region fitted: the road ahead, up to ground_max_depth ahead and ground_max_lateral to
+  // either side (m, the source's units): kerbs and sidewalks beside it are 10-20 cm higher, and
+  // a plane tilted to take them in too reads the height several per cent off.
+  double ground_max_depth = 25.0;
+  double ground_max_lateral = 4.0;
+  double ground_max_tilt_deg = 15.0;  // the ground's normal within this of the camera's up axis
+  double ground_inlier_ratio = 0.05;  // inliers within this fraction of the height
+  int ground_min_inliers = 50;
+  // The map is rescaled when the median height strays from camera_height by more than this
+  // fraction (log). Tighter than anchor_tolerance: the ground is measured, not a mean of noise,
+  // and 1 % of scale is 0.1 m of se3 error over 100 m of road.
+  double ground_tolerance = 0.003;
+  bool GroundScale() const { return camera_height > 0; }
   DepthErrorModel ErrorModel() const { return {error_relative, error_per_metre}; }
   bool IsPrior() const { return ErrorModel().Enabled(); }
   double CloseDepth() const { return close_depth_factor * virtual_baseline; }

@@ -99,6 +99,7 @@ std::vector<System::ColoredPoint> System::MapPointCloud() const {
 size_t System::NumKeyFrames() const { return back_end_.NumKeyFrames(); }
 size_t System::NumMapPoints() const { return back_end_.NumMapPoints(); }
 int System::NumLost() const { return back_end_.NumLost(); }
+std::vector<double> System::GroundHeights() const { return back_end_.GroundHeights(); }
 int System::NumTracked() const { return back_end_.NumTracked(); }
 
 }  // namespace ademono

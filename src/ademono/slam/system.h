@@ -101,6 +101,9 @@ class System {
   size_t NumKeyFrames() const;
   size_t NumMapPoints() const;
   int NumLost() const;
+  // depth.camera_height: the camera heights above the ground plane measured so far, in the
+  // map's units (Tracking::GroundHeights).
+  std::vector<double> GroundHeights() const;
   int NumTracked() const;
   const Camera& GetCamera() const { return camera_; }
   const SystemOptions& Options() const { return options_; }

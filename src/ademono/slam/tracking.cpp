@@ -11,7 +11,9 @@
 #include <opencv2/calib3d.hpp>
 
 #include "ademono/core/cv_geometry.h"
+#include "ademono/core/statistics.h"
 #include "ademono/optimize/depth_scale.h"
+#include "ademono/optimize/ground_plane.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/keyframe.h"
 #include "ademono/slam/matcher.h"
@@ -104,8 +106,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
                                double timestamp, std::vector<uint8_t> in_dynamic_box) {
   FollowLoopCorrection();
   in_dynamic_box_ = std::move(in_dynamic_box);
-  // Network depth starts from the last frame's correction (its scale wanders slowly).
-  if (features->DepthIsPrior() && last_depth_scale_ != 1.0) {
+  // Network depth starts from the last frame's correction (its scale wanders slowly); with a
+  // known camera height every frame starts at the ground's scale (RescaleWorld keeps
+  // last_depth_scale_ at it).
+  if ((features->DepthIsPrior() || options_.depth.GroundScale()) && last_depth_scale_ != 1.0) {
     features = RescaleDepth(*features, static_cast<float>(last_depth_scale_));
   }
   Frame frame(next_frame_id_++, index, timestamp, std::move(features));
@@ -116,6 +120,16 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   geometric_culled_ = 0;
 
   if (state_ == TrackingState::kNotInitialized) {
+    if (options_.depth.GroundScale() && ground_heights_.empty()) {
+      // The first map is made at the ground's scale, measured on the frame's own depths
+      // (nothing to rescale yet).
+      if (const std::optional<double> height = MeasureGround(frame, false)) {
+        const double factor = options_.depth.camera_height / *height;
+        frame.features = RescaleDepth(frame.F(), static_cast<float>(factor));
+        last_depth_scale_ = frame.F().depth_scale;
+        ground_heights_.push_back(*height * factor);
+      }
+    }
     ok = Initialise(frame, Rigid3d::Identity());
     if (ok) out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
   } else {
@@ -224,6 +238,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
+        if (options_.depth.GroundScale() && !map_loaded_) {
+          if (const std::optional<double> height = MeasureGround(frame, true))
+            ground_heights_.push_back(*height);
+        }
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame, &out.created_points);
       }
@@ -349,14 +367,49 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
 
 void Tracking::AnchorScale(Frame& frame) {
   // A loaded map's scale is the anchor (this session's network may read differently).
-  if (!frame.F().DepthIsPrior() || !options_.depth.anchor_scale || log_scale_count_ == 0 ||
-      !local_mapping_.Idle() || map_loaded_) {
+  if (!local_mapping_.Idle() || map_loaded_) return;
+  if (options_.depth.GroundScale()) {
+    // The camera's height above the ground as the map has it, over the keyframes so far.
+    if (ground_heights_.empty()) return;
+    const double factor = options_.depth.camera_height / Median(ground_heights_);
+    if (std::abs(std::log(factor)) > options_.depth.ground_tolerance) RescaleWorld(frame, factor);
     return;
   }
+  if (!frame.F().DepthIsPrior() || !options_.depth.anchor_scale || log_scale_count_ == 0) return;
   // This frame counts too (it is added to the sum after tracking).
   const double mean = (log_scale_sum_ + std::log(frame.F().depth_scale)) / (log_scale_count_ + 1);
   if (std::abs(mean) <= options_.depth.anchor_tolerance) return;
   RescaleWorld(frame, std::exp(-mean));
+}
+
+std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_points) const {
+  const FrameFeatures& f = frame.F();
+  std::vector<Eigen::Vector3d> points;
+  auto add = [&](const Eigen::Vector3d& p) {
+    if (p.y() > 0 && p.z() > 0 && p.z() <= options_.depth.ground_max_depth &&
+        std::abs(p.x()) <= options_.depth.ground_max_lateral) {
+      points.push_back(p);
+    }
+  };
+  if (map_points) {
+    // The local map's points ahead (the ones the frame tracks are too few on a road that
+    // streams past: 30-50 against 200 keypoints with depth).
+    for (const auto& point : local_points_) {
+      if (point && !point->bad && UsableForPose(*point)) add(*frame.cam_from_world * point->position);
+    }
+  } else {
+    for (size_t i = 0; i < f.Size(); ++i) {
+      if (!(f.depth[i] > 0) || (i < in_dynamic_box_.size() && in_dynamic_box_[i])) continue;
+      add(f.UnprojectCamera(i) / f.depth_scale);  // the source's own units
+    }
+  }
+  GroundPlaneOptions options;
+  options.max_tilt_deg = options_.depth.ground_max_tilt_deg;
+  options.inlier_ratio = options_.depth.ground_inlier_ratio;
+  options.min_inliers = options_.depth.ground_min_inliers;
+  const GroundPlane plane = EstimateGroundPlane(points, options);
+  if (!plane.valid) return std::nullopt;
+  return plane.height;
 }
 
 void Tracking::RescaleWorld(Frame& frame, double factor) {
@@ -374,6 +427,7 @@ void Tracking::RescaleWorld(Frame& frame, double factor) {
   // The history is now measured against the rescaled map.
   log_scale_sum_ += log_scale_count_ * std::log(factor);
   last_depth_scale_ *= factor;
+  for (double& h : ground_heights_) h *= factor;  // lengths in the map
 }
 
 int Tracking::OptimizeFramePose(Frame& frame, double min_static, bool map_points_only) {

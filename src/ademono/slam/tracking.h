@@ -108,6 +108,10 @@ class Tracking {
   // `localize_only` the map never changes: no keyframe, no point, no point statistics.
   void StartInLoadedMap(bool localize_only) ADEMONO_REQUIRES(map_.mutex);
   bool LocalizeOnly() const { return localize_only_; }
+  // depth.camera_height: the camera's height above the ground plane, measured at initialisation
+  // and at every keyframe, in the map's current units (the map is rescaled whenever their
+  // median strays from camera_height by more than depth.anchor_tolerance).
+  const std::vector<double>& GroundHeights() const { return ground_heights_; }
   // For the analysis (core/thread_annotations.h): the caller holds the map's mutex under another
   // name (its own reference to the map). Checked at run time.
   void AssertMapHeld() const ADEMONO_ASSERT_CAPABILITY(map_.mutex) { map_.mutex.AssertHeld(); }
@@ -150,8 +154,15 @@ class Tracking {
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
   void CorrectDepthScale(Frame& frame, bool inliers_only) ADEMONO_REQUIRES(map_.mutex);
-  // Keeps the map at the network's long-run mean scale (rescales the world when it drifted).
+  // Keeps the map at the network's long-run mean scale, or with depth.camera_height at the scale
+  // that puts the camera camera_height above the ground (rescales the world when it drifted).
   void AnchorScale(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // depth.camera_height: the camera's height above the ground plane fitted to the frame's
+  // keypoints below the horizon, off dynamic boxes and in the corridor ahead: on the map points
+  // they track (`map_points`, map units: the map's own scale, whatever biased it) or on their
+  // own depths (the source's units, before any correction; for the first map).
+  std::optional<double> MeasureGround(const Frame& frame, bool map_points) const
+      ADEMONO_REQUIRES(map_.mutex);
   // Multiplies every length of the map and of the tracker's state by `factor`.
   void RescaleWorld(Frame& frame, double factor) ADEMONO_REQUIRES(map_.mutex);
 
@@ -178,6 +189,7 @@ class Tracking {
   double last_depth_scale_ = 1.0;  // the last tracked frame's network scale correction
   double log_scale_sum_ = 0.0;     // sum of log(depth_scale) over tracked frames
   int log_scale_count_ = 0;
+  std::vector<double> ground_heights_;  // depth.camera_height: GroundHeights()
   bool map_loaded_ = false;
   bool localize_only_ = false;
   // Localisation only without a temporary map (tracking.temporary_map false): frame-to-frame

@@ -1,0 +1,17 @@
+#include "ademono/core/statistics.h"
+
+#include <algorithm>
+
+namespace ademono {
+
+double Median(std::vector<double> values) {
+  const size_t n = values.size();
+  if (n == 0) return 0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  const double upper = *mid;
+  if (n % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(values.begin(), mid));
+}
+
+}  // namespace ademono
