@@ -76,9 +76,9 @@ struct FrameDepthOptions {
   double ground_inlier_ratio = 0.05;  // inliers within this fraction of the height
   int ground_min_inliers = 50;
   // The map is rescaled when the median height strays from camera_height by more than this
-  // fraction (log). Tighter than anchor_tolerance: the ground is measured, not a mean of noise,
-  // and 1 % of scale is 0.1 m of se3 error over 100 m of road.
-  double ground_tolerance = 0.003;
+  // fraction (log). Far tighter than anchor_tolerance: the ground is measured, not a mean of
+  // noise, and over a 150 m drive 0.3 % of scale is already about 0.1 m of se3 error.
+  double ground_tolerance = 0.001;
   bool GroundScale() const { return camera_height > 0; }
   DepthErrorModel ErrorModel() const { return {error_relative, error_per_metre}; }
   bool IsPrior() const { return ErrorModel().Enabled(); }
