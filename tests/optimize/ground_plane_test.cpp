@@ -17,7 +17,8 @@ std::vector<Eigen::Vector3d> Road(double height, const Eigen::Matrix3d& cam_from
                                   double x_from, double x_to) {
   std::vector<Eigen::Vector3d> points;
   for (double z = 5; z <= 25; z += 1.0) {
-    for (double x = x_from; x <= x_to; x += 0.5) points.push_back(cam_from_level * Eigen::Vector3d(x, height, z));
+    for (double x = x_from; x <= x_to; x += 0.5)
+      points.push_back(cam_from_level * Eigen::Vector3d(x, height, z));
   }
   return points;
 }

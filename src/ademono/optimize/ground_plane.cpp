@@ -36,16 +36,9 @@ bool Orient(Eigen::Vector3d normal, double offset, Plane* plane) {
   return true;
 }
 
-int CountInliers(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double tolerance,
-                 std::vector<char>* inlier) {
+int CountInliers(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double tolerance) {
   int n = 0;
-  if (inlier) inlier->assign(points.size(), 0);
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (std::abs(Distance(plane, points[i])) <= tolerance) {
-      ++n;
-      if (inlier) (*inlier)[i] = 1;
-    }
-  }
+  for (const Eigen::Vector3d& p : points) n += std::abs(Distance(plane, p)) <= tolerance ? 1 : 0;
   return n;
 }
 
@@ -74,11 +67,12 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
   for (int it = 0; it < options.iterations; ++it) {
     const size_t a = rng() % n, b = rng() % n, c = rng() % n;
     if (a == b || b == c || a == c) continue;
-    const Eigen::Vector3d normal = (points_cam[b] - points_cam[a]).cross(points_cam[c] - points_cam[a]);
+    const Eigen::Vector3d normal =
+        (points_cam[b] - points_cam[a]).cross(points_cam[c] - points_cam[a]);
     Plane plane;
     if (!Orient(normal, -normal.dot(points_cam[a]), &plane)) continue;
     if (plane.normal.dot(up) < min_up || !(plane.height > 0)) continue;
-    const int count = CountInliers(plane, points_cam, options.inlier_ratio * plane.height, nullptr);
+    const int count = CountInliers(plane, points_cam, options.inlier_ratio * plane.height);
     if (count > best_count) {
       best_count = count;
       best = plane;
@@ -123,7 +117,7 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
     return result;
   }
   best = refit;
-  const int count = CountInliers(best, points_cam, options.inlier_ratio * best.height, nullptr);
+  const int count = CountInliers(best, points_cam, options.inlier_ratio * best.height);
   if (count < options.min_inliers || count < options.min_inlier_share * static_cast<double>(n)) {
     return result;
   }

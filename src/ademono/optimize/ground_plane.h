@@ -6,9 +6,11 @@
 // network's bias (slam/tracking.h, depth.camera_height).
 //
 // RANSAC over planes through three points whose normal lies within max_tilt_deg of the camera's
-// up axis (-y), inliers within inlier_ratio * height of the plane; the best plane is refitted to
-// its inliers by least squares. Deterministic: a fixed-seed std::mt19937, taken modulo (the
-// engine's sequence is fixed by the standard, unlike the distributions).
+// up axis (-y), inliers within inlier_ratio * height of the plane; the best plane is refitted by
+// maximum likelihood for depth errors proportional to depth (ground_plane.cpp). A raised surface
+// as populous as the road beside it (a sidewalk 15 cm up) draws a plane through both: callers
+// pass a corridor ahead. Deterministic: a fixed-seed std::mt19937, taken modulo (the engine's
+// sequence is fixed by the standard, unlike the distributions).
 
 #include <Eigen/Core>
 
@@ -17,9 +19,9 @@
 namespace ademono {
 
 struct GroundPlaneOptions {
-  double max_tilt_deg = 15.0;   // the plane's normal within this angle of the camera's up axis
-  double inlier_ratio = 0.05;   // inlier distance as a fraction of the candidate's height
-  int min_inliers = 50;         // fewer: no estimate
+  double max_tilt_deg = 15.0;     // the plane's normal within this angle of the camera's up axis
+  double inlier_ratio = 0.05;     // inlier distance as a fraction of the candidate's height
+  int min_inliers = 50;           // fewer: no estimate
   double min_inlier_share = 0.2;  // of the points given
   int iterations = 300;
   void Check() const;  // throws std::invalid_argument
@@ -27,8 +29,9 @@ struct GroundPlaneOptions {
 
 struct GroundPlane {
   bool valid = false;
-  Eigen::Vector3d normal = Eigen::Vector3d(0, -1, 0);  // unit, pointing from the plane to the camera
-  double height = 0.0;  // camera's distance above the plane, in the points' units
+  Eigen::Vector3d normal =
+      Eigen::Vector3d(0, -1, 0);  // unit, pointing from the plane to the camera
+  double height = 0.0;            // camera's distance above the plane, in the points' units
   int num_inliers = 0;
 };
 

@@ -395,7 +395,8 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
     // The local map's points ahead (the ones the frame tracks are too few on a road that
     // streams past: 30-50 against 200 keypoints with depth).
     for (const auto& point : local_points_) {
-      if (point && !point->bad && UsableForPose(*point)) add(*frame.cam_from_world * point->position);
+      if (!point || point->bad || !UsableForPose(*point)) continue;
+      add(*frame.cam_from_world * point->position);
     }
   } else {
     for (size_t i = 0; i < f.Size(); ++i) {
