@@ -14,8 +14,8 @@
 #include "ademono/depth/simulated_depth.h"
 #include "ademono/eval/trajectory_eval.h"
 #include "ademono/slam/system.h"
-#include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
+#include "synthetic_run.h"
 
 namespace ademono {
 namespace {
@@ -36,8 +36,6 @@ StreetRun RunStreet(double camera_height, bool error_model) {
   scene_options.frames = 40;
   scene_options.seed = 2;
   const synth::Scene scene = synth::BuildScene(scene_options);
-  synth::GeneratorOptions generator;
-  generator.scene = scene_options;
   SimulatedDepthOptions network;
   network.scale = kNetworkScale;
   network.seed = 2;
@@ -51,18 +49,12 @@ StreetRun RunStreet(double camera_height, bool error_model) {
     options.depth.error_per_metre = network.b;
   }
   System system(scene.camera, options);
-  StreetRun run;
-  Trajectory truth;
-  for (size_t k = 0; k < scene_options.frames; ++k) {
-    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, k, generator);
-    FrameData frame;
-    frame.index = k;
-    frame.timestamp = scene.TimeOf(k);
-    frame.image = rendered.image;
-    run.tracked += system.TrackFrame(frame, depth.Degrade(rendered.depth, k), {}).tracked;
-    truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
-  }
+  const testing_util::SyntheticRun tracked =
+      testing_util::TrackSyntheticScene(scene, scene_options, depth, system);
   system.Shutdown();
+  StreetRun run;
+  run.tracked = tracked.tracked;
+  const Trajectory& truth = tracked.truth;
   run.ground_heights = system.GroundHeights();
   EvalOptions eval;
   eval.alignment = Alignment::kSim3;

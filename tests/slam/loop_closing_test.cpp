@@ -9,9 +9,9 @@
 #include "ademono/depth/simulated_depth.h"
 #include "ademono/eval/trajectory_eval.h"
 #include "ademono/slam/system.h"
-#include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
 #include "simulated_network.h"
+#include "synthetic_run.h"
 
 namespace ademono {
 namespace {
@@ -32,21 +32,14 @@ SystemOptions NetworkOptions(bool loop) {
 LoopRun RunScene(const synth::SceneOptions& scene_options, const SystemOptions& options,
             uint64_t depth_seed) {
   const synth::Scene scene = synth::BuildScene(scene_options);
-  synth::GeneratorOptions generator;
-  generator.scene = scene_options;
   const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(200, depth_seed), nullptr);
   LoopRun run;
   System system(scene.camera, options);
-  for (size_t k = 0; k < scene_options.frames; ++k) {
-    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, k, generator);
-    FrameData frame;
-    frame.index = k;
-    frame.timestamp = scene.TimeOf(k);
-    frame.image = rendered.image;
-    run.tracked += system.TrackFrame(frame, network.Degrade(rendered.depth, k), {}).tracked;
-    run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
-  }
+  testing_util::SyntheticRun tracked =
+      testing_util::TrackSyntheticScene(scene, scene_options, network, system);
   system.Shutdown();
+  run.tracked = tracked.tracked;
+  run.truth = std::move(tracked.truth);
   run.loops = system.Loops();
   run.estimate = system.FrameTrajectory();
   EvalOptions eval;

@@ -16,6 +16,7 @@
 #include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
 #include "simulated_network.h"
+#include "synthetic_run.h"
 
 namespace ademono {
 namespace {
@@ -41,25 +42,16 @@ NetworkRun RunOffice(bool scale_correction, size_t frames) {
   scene_options.seed = 5;
   scene_options.persons = 1;
   const synth::Scene scene = synth::BuildScene(scene_options);
-  synth::GeneratorOptions generator;
-  generator.scene = scene_options;
-
   const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(60, 3), nullptr);
 
   NetworkRun run;
   System system(scene.camera, NetworkOptions(scale_correction));
-  for (size_t k = 0; k < frames; ++k) {
-    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, k, generator);
-    FrameData frame;
-    frame.index = k;
-    frame.timestamp = scene.TimeOf(k);
-    frame.image = rendered.image;
-    const TrackResult result = system.TrackFrame(frame, network.Degrade(rendered.depth, k), {});
-    run.tracked += result.tracked ? 1 : 0;
-    run.true_scales.push_back(network.FrameScale(k));
-    run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
-  }
+  testing_util::SyntheticRun tracked =
+      testing_util::TrackSyntheticScene(scene, scene_options, network, system);
   system.Shutdown();
+  run.tracked = tracked.tracked;
+  run.truth = std::move(tracked.truth);
+  for (size_t k = 0; k < frames; ++k) run.true_scales.push_back(network.FrameScale(k));
   run.depth_scales = system.DepthScales();
   run.estimate = system.FrameTrajectory();
   return run;
