@@ -19,7 +19,7 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
       ->required();
   app.add_option("--config", args.config, "config YAML (default: configs/<family>.yaml)");
   app.add_option("--depth", args.depth,
-                 "sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
+                 "none | sensor | cache:DIR | simulated[:k=v,...] | model:FILE.onnx")
       ->capture_default_str();
   app.add_option("--detector", args.detector, "none | cache:FILE.jsonl | model:FILE.onnx")
       ->capture_default_str();
@@ -113,10 +113,12 @@ fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequen
       DefaultConfig(sequence.Kind(), sequence.Path().string(), sequence.GetCamera());
   std::string name = choice.name;
   std::string why = choice.why;
-  if (depth.network) {
+  if (depth.network || depth.none) {
+    // The monocular core's two families, with a network or without depth.
     const bool outdoor = depth.domain == "outdoor" || (depth.domain.empty() && sequence.Kind() == "kitti");
     name = outdoor ? "network_outdoor.yaml" : "network_indoor.yaml";
-    why = std::string("depth from a network, ") + (outdoor ? "outdoor" : "indoor");
+    why = std::string(depth.none ? "no depth (monocular), " : "depth from a network, ") +
+          (outdoor ? "outdoor" : "indoor");
   }
   const fs::path candidate = dir / name;
   if (!dir.empty() && fs::exists(candidate)) {
@@ -130,6 +132,17 @@ fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequen
 
 void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
   const DepthSourceInfo depth = DescribeDepthSource(depth_arg);
+  if (depth.none) {
+    // Whatever the config: without depth only the monocular core can run, and no error model
+    // describes depths that do not exist.
+    options.tracking.monocular = true;
+    options.depth.error_relative = 0;
+    options.depth.error_per_metre = 0;
+    options.depth.camera_height = 0;
+    // The enhancement walk is weighted by depth: without depth it would only drop keypoints.
+    options.filter.enable_enhancement = false;
+    return;
+  }
   if (!depth.network || !depth.error_model.Enabled() || !options.depth.IsPrior()) return;
   options.depth.error_relative = depth.error_model.relative;
   options.depth.error_per_metre = depth.error_model.per_metre;

@@ -13,6 +13,10 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
   const std::string kind = spec.substr(0, colon);
   const std::string argument = colon == std::string::npos ? "" : spec.substr(colon + 1);
 
+  if (kind == "none") {
+    if (!argument.empty()) throw InputError("depth provider 'none' takes no argument");
+    return nullptr;
+  }
   if (kind == "sensor") {
     if (!argument.empty()) throw InputError("depth provider 'sensor' takes no argument");
     return std::make_unique<SensorDepthProvider>(context.sequence);
@@ -27,10 +31,15 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
   if (kind == "model") return MakeOnnxDepthProvider(argument, context);
 
   throw InputError("unknown depth provider '" + spec +
-                   "' (expected sensor, cache:DIR, simulated[:k=v,...] or model:FILE.onnx)");
+                   "' (expected none, sensor, cache:DIR, simulated[:k=v,...] or model:FILE.onnx)");
 }
 
 DepthSourceInfo DescribeDepthSource(const std::string& spec) {
+  if (spec == "none") {
+    DepthSourceInfo info;
+    info.none = true;
+    return info;
+  }
   const size_t colon = spec.find(':');
   if (spec.substr(0, colon) != "model") return {};
   return DescribeModelDepth(colon == std::string::npos ? "" : spec.substr(colon + 1));

@@ -5,6 +5,7 @@
 //                                  matched to frames by file-name stem or timestamp
 //   simulated[:k=v,...]            network-like errors applied to the dataset's depth (synth)
 //   model:FILE.onnx[,spec=Y.yaml]  a metric-depth ONNX model through ONNX Runtime
+//   none                           no depth at all: the monocular core (returns null)
 // Throws InputError for an unknown kind or a bad argument (naming the file for cache/model).
 
 #include <cstdint>
@@ -29,6 +30,7 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
 // What a depth spec is, before any provider is built: `run` picks its settings family from it
 // (network depth gets configs/network_<domain>.yaml) and takes a model's error model.
 struct DepthSourceInfo {
+  bool none = false;           // `none`: monocular without depth (no metric scale)
   bool network = false;        // a learned network (model:...), a prior rather than a sensor
   std::string domain;          // the model spec's "indoor" / "outdoor", "" if it says nothing
   DepthErrorModel error_model;  // the model spec's uncertainty (disabled if none)

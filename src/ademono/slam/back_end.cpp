@@ -16,12 +16,13 @@ BackEnd::BackEnd(const Camera& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
       keyframe_database_(options.place),
-      local_mapping_(map_, options.mapping),
+      local_mapping_(map_, options.mapping, options.tracking.monocular,
+                     options.depth.IsPrior() ? options.depth.error_relative : 0.0),
       tracking_(map_, local_mapping_, options) {
   map_.SetKeyFrameDatabase(&keyframe_database_);
   if (options_.loop.enabled) {
     loop_closing_ = std::make_unique<LoopClosing>(
-        map_, keyframe_database_, options_.loop, options_.loop.UseSim3(options_.depth.IsPrior()),
+        map_, keyframe_database_, options_.loop, options_.loop.UseSim3(options_.depth.IsPrior() || options_.tracking.monocular),
         options_.mapping.fuse_radius);
     local_mapping_.SetLoopClosing(loop_closing_.get());
   }

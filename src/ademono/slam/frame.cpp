@@ -33,8 +33,10 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        cv::Mat descriptors,
                                                        std::vector<float> depth,
                                                        const DepthErrorModel& depth_error,
-                                                       bool weight_by_error_model) {
+                                                       bool weight_by_error_model,
+                                                       bool monocular) {
   auto f = std::make_shared<FrameFeatures>();
+  f->monocular = monocular;
   f->depth_error = depth_error;
   f->weight_by_error_model = weight_by_error_model;
   f->camera = camera;
@@ -75,7 +77,7 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
   const double bf = f->intrinsics.bf;
   for (size_t i = 0; i < n; ++i) {
     if (f->depth[i] > 0) {
-      f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+      if (!monocular) f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
     } else {
       f->depth[i] = -1.f;
     }
@@ -110,6 +112,7 @@ std::shared_ptr<const FrameFeatures> WithoutKeypoints(const FrameFeatures& featu
   f->descriptors = cv::Mat(0, features.descriptors.cols, features.descriptors.type());
   f->depth_error = features.depth_error;
   f->weight_by_error_model = features.weight_by_error_model;
+  f->monocular = features.monocular;
   f->depth_scale = features.depth_scale;
   return f;  // no grid either: FeaturesInArea finds nothing
 }
@@ -121,7 +124,7 @@ std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features,
   for (size_t i = 0; i < f->Size(); ++i) {
     if (!(f->depth[i] > 0)) continue;
     f->depth[i] *= scale;
-    f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+    if (!f->monocular) f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
   }
   return f;
 }
@@ -161,6 +164,14 @@ ImageObservation FrameFeatures::Observation(size_t i) const {
     const double z = depth[i];
     o.depth_inv_sigma = z * z / (intrinsics.bf * depth_error.Sigma(z));
   }
+  return o;
+}
+
+ImageObservation FrameFeatures::PriorObservation(size_t i) const {
+  ImageObservation o = Observation(i);
+  const double z = depth[i];
+  o.u_right = keypoints_un[i].pt.x - intrinsics.bf / z;
+  if (depth_error.Enabled() && z > 0) o.depth_inv_sigma = z * z / (intrinsics.bf * depth_error.Sigma(z));
   return o;
 }
 

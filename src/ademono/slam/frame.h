@@ -46,6 +46,10 @@ struct FrameFeatures {
   // Error model of `depth` (disabled for sensor depth); scaled with the depths it describes.
   DepthErrorModel depth_error;
   bool weight_by_error_model = true;  // false: the virtual baseline's weighting (ablation)
+  // Monocular (tracking.monocular): the depths are no measurement. No u_right (2-dof residuals,
+  // no depth check in matching); the depths only seed the first map, measure the scale and give
+  // the priors of points geometry cannot place (PriorObservation).
+  bool monocular = false;
   float depth_scale = 1.f;  // factor applied to the source's depths (network scale correction)
   std::vector<std::vector<size_t>> grid;  // kGridCols * kGridRows cells of keypoint indices
 
@@ -58,6 +62,9 @@ struct FrameFeatures {
     return u >= min_x && u < max_x && v >= min_y && v < max_y;
   }
   ImageObservation Observation(size_t i) const;
+  // Keypoint i with its depth as a 3-dof (u, v, u_right) observation weighted by the error model,
+  // also in monocular mode (a network depth prior); requires depth[i] > 0.
+  ImageObservation PriorObservation(size_t i) const;
   // Camera-frame point of keypoint i from its depth (requires depth[i] > 0).
   Eigen::Vector3d UnprojectCamera(size_t i) const;
   bool IsClose(size_t i) const { return depth[i] > 0 && depth[i] < close_depth; }
@@ -73,7 +80,8 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
                                                        cv::Mat descriptors,
                                                        std::vector<float> depth,
                                                        const DepthErrorModel& depth_error = {},
-                                                       bool weight_by_error_model = true);
+                                                       bool weight_by_error_model = true,
+                                                       bool monocular = false);
 
 // The features without any keypoint (camera, pyramid, bounds and depth model kept): what a culled
 // keyframe needs, whose pose still resolves the frames that referenced it.

@@ -79,7 +79,8 @@ FilteredFrame FrontEnd::Filter(const ExtractedFrame& extracted,
   out.features =
       MakeFrameFeatures(camera_, pyramid_, options_.depth.virtual_baseline,
                         options_.depth.CloseDepth(), kept_keypoints, kept_descriptors, kept_depths,
-                        options_.depth.ErrorModel(), options_.depth.uncertainty_weighting);
+                        options_.depth.ErrorModel(), options_.depth.uncertainty_weighting,
+                        options_.tracking.monocular);
   // Map points are culled when they keep landing in dynamic boxes; only boxes the filter found
   // to hold a moving object count, so a static person's (or parked car's) points survive.
   for (const Detection& d : detections) {

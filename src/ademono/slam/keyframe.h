@@ -8,6 +8,7 @@
 #include <set>
 #include <vector>
 
+#include "ademono/optimize/network_depth_model.h"
 #include "ademono/slam/frame.h"
 #include "ademono/slam/map_point.h"
 
@@ -35,6 +36,9 @@ class KeyFrame {
   // Part of a map loaded for localisation only: its pose and its map points never change, it is
   // never culled (temporary keyframes may connect to it in the covisibility graph).
   bool frozen = false;
+  // Monocular core with a network: the network's error in this view against the triangulated
+  // points (local mapping refits it after each local BA that moves the keyframe).
+  InverseDepthAffine network_fit;
 
   // Scratch of the tracker and local mapping.
   uint64_t local_map_frame = UINT64_MAX;

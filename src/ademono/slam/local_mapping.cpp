@@ -7,14 +7,21 @@
 #include <cmath>
 #include <ctime>
 
+#include "ademono/core/statistics.h"
 #include "ademono/optimize/bundle_adjustment.h"
+#include "ademono/optimize/network_depth_model.h"
 #include "ademono/optimize/residuals.h"
 #include "ademono/optimize/triangulation.h"
 #include "ademono/slam/matcher.h"
 
 namespace ademono {
 
-LocalMapping::LocalMapping(Map& map, const MappingOptions& options) : map_(map), options_(options) {
+LocalMapping::LocalMapping(Map& map, const MappingOptions& options, bool monocular,
+                           double configured_sigma_log)
+    : map_(map),
+      options_(options),
+      monocular_(monocular),
+      configured_sigma_log_(configured_sigma_log) {
   options_.Check();
   if (options_.threaded) worker_ = std::thread([this] { Run(); });
 }
@@ -122,7 +129,10 @@ void LocalMapping::Merge() {
   const double start_cpu = ThreadCpuMs();
   {
     MutexLock lock(map_.mutex);
-    if (pending->has_ba) ApplyBundleAdjustment(*pending);
+    if (pending->has_ba) {
+      ApplyBundleAdjustment(*pending);
+      if (monocular_ && configured_sigma_log_ > 0) MeasureNetworkErrors(*pending);
+    }
     CullKeyFrames(*pending->keyframe);
     const double cull_ms = MsSinceStart(start);
     if (loop_closing_ != nullptr && !pending->keyframe->bad) {
@@ -215,7 +225,7 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
   const float ratio_factor = 1.5f * f1.pyramid->scale_factors.at(std::min<size_t>(
                                         1, f1.pyramid->scale_factors.size() - 1));
   const Eigen::Vector3d center1 = keyframe.CameraCenter();
-  const Matcher matcher(0.6f, false);
+  const Matcher matcher(static_cast<float>(options_.triangulation_match_ratio), false);
   int created = 0;
   for (KeyFrame* k2 : keyframe.BestCovisibles(options_.triangulation_neighbours)) {
     // A loaded map's keyframe (localisation only) takes no new point.
@@ -229,7 +239,8 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
     std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
     const double median_depth = depths[depths.size() / 2];
     const double baseline = (k2->CameraCenter() - center1).norm();
-    if (!(median_depth > 0) || baseline / median_depth < 0.01) continue;
+    if (!(median_depth > 0) || baseline / median_depth < options_.triangulation_min_baseline_ratio)
+      continue;
 
     std::vector<std::pair<size_t, size_t>> matches;
     matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches);
@@ -408,7 +419,12 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       for (const auto& [kf, idx] : p->observations) {
         auto it = camera_index.find(kf);
         if (it == camera_index.end()) continue;
-        problem.observations.push_back({it->second, point_index, kf->F().Observation(idx)});
+        // The network's depth holds the point only where geometry cannot yet.
+        const bool prior = monocular_ && p->depth_prior && kf == p->reference &&
+                           kf->F().depth[idx] > 0 && PriorActive(*p);
+        problem.observations.push_back({it->second, point_index,
+                                        prior ? kf->F().PriorObservation(idx)
+                                              : kf->F().Observation(idx)});
         observation_refs.emplace_back(kf, idx);
       }
     }
@@ -455,8 +471,9 @@ void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
     for (size_t i = 0; i < kf->map_points.size(); ++i) {
       const auto& p = kf->map_points[i];
       if (!p || p->bad) continue;
-      // RGB-D: only close points count (far ones are not reliable enough to decide).
-      if (!kf->F().IsClose(i)) continue;
+      // RGB-D: only close points count (far ones are not reliable enough to decide);
+      // monocular: every point (ORB-SLAM).
+      if (!monocular_ && !kf->F().IsClose(i)) continue;
       ++num_points;
       if (p->NumObservations() <= options_.redundant_observers) continue;
       const int level = kf->F().keypoints_un[i].octave;
@@ -471,6 +488,57 @@ void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
     }
     if (num_points > 0 && num_redundant > options_.redundant_ratio * num_points)
       map_.EraseKeyFrame(kf);
+  }
+}
+
+double LocalMapping::NetworkSigmaLog() const {
+  if (sigma_logs_.empty()) return configured_sigma_log_;
+  // The recent keyframes' (the network's error depends on the scene it sees).
+  constexpr size_t kRecent = 20;
+  const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;
+  return Median(std::vector<double>(sigma_logs_.begin() + static_cast<long>(start),
+                                    sigma_logs_.end()));
+}
+
+bool LocalMapping::PriorActive(const MapPoint& p) const {
+  const KeyFrame* ref = p.reference;
+  if (ref == nullptr || ref->bad) return false;
+  const auto it = p.observations.find(const_cast<KeyFrame*>(ref));
+  if (it == p.observations.end()) return false;
+  // Depth from parallax alpha with an angular keypoint error sigma_theta: relative sigma
+  // sigma_theta / alpha (two views; more views only do better).
+  const Eigen::Vector3d ray_ref = (p.position - ref->CameraCenter()).normalized();
+  double max_angle = 0.0;
+  for (const auto& [kf, idx] : p.observations) {
+    if (kf == ref || kf->bad) continue;
+    const Eigen::Vector3d ray = (p.position - kf->CameraCenter()).normalized();
+    max_angle = std::max(max_angle, std::acos(std::clamp(ray_ref.dot(ray), -1.0, 1.0)));
+  }
+  const FrameFeatures& f = ref->F();
+  const double sigma_px = f.pyramid->scale_factors[f.keypoints_un[it->second].octave];
+  const double sigma_theta = sigma_px / f.intrinsics.fx;
+  return sigma_theta > NetworkSigmaLog() * max_angle;
+}
+
+void LocalMapping::MeasureNetworkErrors(const Pending& pending) {
+  for (size_t c = 0; c < pending.cameras.size(); ++c) {
+    if (pending.problem.cameras[c].fixed) continue;
+    KeyFrame& kf = *pending.cameras[c];
+    if (kf.bad) continue;
+    const FrameFeatures& f = kf.F();
+    std::vector<double> map_depths, network_depths;
+    for (size_t i = 0; i < kf.map_points.size(); ++i) {
+      const auto& p = kf.map_points[i];
+      if (!p || p->bad || !(f.depth[i] > 0) || p->NumObservations() < 2) continue;
+      if (p->depth_prior && PriorActive(*p)) continue;  // held by the network: no evidence
+      map_depths.push_back((kf.cam_from_world * p->position).z());
+      // The network's own reading (undo the per-frame scale correction it was given).
+      network_depths.push_back(f.depth[i] / f.depth_scale);
+    }
+    const InverseDepthAffine fit = FitInverseDepthAffine(map_depths, network_depths);
+    if (!fit.valid) continue;
+    kf.network_fit = fit;
+    if (&kf == pending.keyframe.get()) sigma_logs_.push_back(fit.sigma_log);
   }
 }
 

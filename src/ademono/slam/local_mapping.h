@@ -32,7 +32,11 @@ namespace ademono {
 
 class LocalMapping {
  public:
-  LocalMapping(Map& map, const MappingOptions& options);
+  // `monocular`: the monocular core (tracking.monocular): every point counts in keyframe
+  // culling, and triangulation keeps away from the epipole.
+  // `configured_sigma_log`: the network's relative depth error as configured (0: no network).
+  LocalMapping(Map& map, const MappingOptions& options, bool monocular = false,
+               double configured_sigma_log = 0.0);
   ~LocalMapping();
   LocalMapping(const LocalMapping&) = delete;
   LocalMapping& operator=(const LocalMapping&) = delete;
@@ -54,6 +58,13 @@ class LocalMapping {
   size_t QueueSize() const { return Idle() ? 0 : 1; }
   // Merges the pending keyframe and stops the worker. Idempotent.
   void Shutdown();
+  // Monocular core with a network: the network's per-point error (robust spread of log depth
+  // after each keyframe's affine map, InverseDepthAffine::sigma_log) measured so far against
+  // triangulated points, or the configured error model's until there is a measurement.
+  double NetworkSigmaLog() const;
+  // Monocular core with a network: whether point `p`'s network-depth prior still enters local BA
+  // (geometry's depth of it less certain than the network's: too little parallax).
+  bool PriorActive(const MapPoint& p) const ADEMONO_REQUIRES(map_.mutex);
   // Milliseconds of mapping work (structure, BA solve, merge) of the keyframes merged since the
   // last call, each counted once, at its hand-off frame.
   double TakeFinishedMilliseconds();
@@ -87,9 +98,15 @@ class LocalMapping {
   bool GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) ADEMONO_REQUIRES(map_.mutex);
   void ApplyBundleAdjustment(const Pending& pending) ADEMONO_REQUIRES(map_.mutex);
   void CullKeyFrames(KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
+  // Fits each BA keyframe's network error model against its triangulated points (monocular core
+  // with a network) and updates the measured per-point spread.
+  void MeasureNetworkErrors(const Pending& pending) ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   MappingOptions options_;
+  bool monocular_ = false;
+  double configured_sigma_log_ = 0.0;  // the options' error model, until measured
+  std::vector<double> sigma_logs_;     // per fitted keyframe (tracking thread)
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
   LoopClosing* loop_closing_ = nullptr;
   std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below

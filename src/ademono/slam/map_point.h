@@ -41,6 +41,10 @@ class MapPoint {
   // when another view confirms it; until then local BA leaves it out, as the pose does. A mover's
   // point is never admitted (synthetic truth scores this).
   bool admitted = true;
+  // Monocular core with a network: the point was placed by its reference keyframe's network
+  // depth, which local BA keeps as a prior on that observation while geometry cannot place it
+  // (its parallax gives a depth less certain than the network's; LocalMapping).
+  bool depth_prior = false;
   int motion_verdicts = 0;  // the geometric test's verdicts of motion (synthetic truth scores it)
   bool bad = false;
   // Part of a map loaded for localisation only: position, descriptor, normal, statistics and its

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/features2d.hpp>
 
 #include "ademono/feature/orb_extractor.h"
@@ -344,6 +345,12 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
     return true;
   };
 
+  // Camera 1's centre seen from camera 2: near the epipole a depth is ill-defined (ORB-SLAM
+  // skips matches there for keypoints without depth).
+  const bool has_epipole = t.z() > 1e-9 * t.norm();
+  const Eigen::Vector2d epipole =
+      has_epipole ? Eigen::Vector2d(in2.fx * t.x() / t.z() + in2.cx, in2.fy * t.y() / t.z() + in2.cy)
+                  : Eigen::Vector2d::Zero();
   std::vector<int> best1_for2(f2.Size(), -1), dist_for2(f2.Size(), 256);
   for (size_t i = 0; i < f1.Size(); ++i) {
     if (k1.map_points[i] && !k1.map_points[i]->bad) continue;
@@ -372,6 +379,10 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
       const double e = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
       const double sigma2 = f2.pyramid->level_sigma2[kp2.octave];
       if (e * e / line_norm2 >= 3.84 * sigma2) continue;
+      if (has_epipole && f1.monocular && f2.monocular &&
+          (Eigen::Vector2d(kp2.pt.x, kp2.pt.y) - epipole).squaredNorm() <
+              100.0 * f2.pyramid->scale_factors[kp2.octave])
+        continue;
       if (segment) {
         const Eigen::Vector2d ab = seg_b - seg_a;
         const double len2 = ab.squaredNorm();
@@ -413,6 +424,57 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
   for (size_t k = 0; k < found.size(); ++k) {
     if (drop[k]) continue;
     matches.push_back(found[k]);
+    ++n;
+  }
+  return n;
+}
+
+int Matcher::SearchForInitialization(const FrameFeatures& f1, const FrameFeatures& f2,
+                                     std::vector<cv::Point2f>& prev_matched,
+                                     std::vector<int>& matches12, float window) const {
+  matches12.assign(f1.Size(), -1);
+  std::vector<int> matches21(f2.Size(), -1), distance21(f2.Size(), INT32_MAX);
+  RotationHistogram rotations;
+  for (size_t i = 0; i < f1.Size(); ++i) {
+    const cv::KeyPoint& kp1 = f1.keypoints_un[i];
+    const int level = kp1.octave;
+    const std::vector<size_t> candidates =
+        f2.FeaturesInArea(prev_matched[i].x, prev_matched[i].y, window, level, level);
+    if (candidates.empty()) continue;
+    const cv::Mat d1 = f1.descriptors.row(static_cast<int>(i));
+    int best = INT32_MAX, second = INT32_MAX;
+    int best_j = -1;
+    for (size_t j : candidates) {
+      const int d = DescriptorDistance(d1, f2.descriptors.row(static_cast<int>(j)));
+      if (distance21[j] <= d) continue;  // already matched at least as well
+      if (d < best) {
+        second = best;
+        best = d;
+        best_j = static_cast<int>(j);
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best_j < 0 || best > kOrbDistanceLow) continue;
+    if (static_cast<float>(best) >= nn_ratio_ * static_cast<float>(second)) continue;
+    const size_t j = static_cast<size_t>(best_j);
+    if (matches21[j] >= 0) matches12[static_cast<size_t>(matches21[j])] = -1;  // taken over
+    matches12[i] = best_j;
+    matches21[j] = static_cast<int>(i);
+    distance21[j] = best;
+  }
+  if (check_orientation_) {
+    for (size_t i = 0; i < f1.Size(); ++i) {
+      if (matches12[i] >= 0)
+        rotations.Add(f1.keypoints[i].angle,
+                      f2.keypoints[static_cast<size_t>(matches12[i])].angle, static_cast<int>(i));
+    }
+    for (int i : rotations.InconsistentMatches()) matches12[static_cast<size_t>(i)] = -1;
+  }
+  int n = 0;
+  for (size_t i = 0; i < f1.Size(); ++i) {
+    if (matches12[i] < 0) continue;
+    prev_matched[i] = f2.keypoints_un[static_cast<size_t>(matches12[i])].pt;
     ++n;
   }
   return n;

@@ -61,6 +61,16 @@ class Matcher {
   int SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
                              std::vector<std::pair<size_t, size_t>>& matches) const;
 
+  // Monocular initialisation (ORB-SLAM's SearchForInitialization): every keypoint of `f1` is
+  // matched with the best keypoint of `f2` on the same pyramid level within `window` px (level 0)
+  // of `prev_matched[i]`, its position in the last frame that matched it (f1's own position at
+  // first): Hamming distance at most kOrbDistanceLow, ratio test, each f2 keypoint kept for its
+  // best f1 keypoint only, rotation consistency. `matches12[i]` is the f2 index or -1; matched
+  // positions replace `prev_matched`. Returns the number of matches.
+  int SearchForInitialization(const FrameFeatures& f1, const FrameFeatures& f2,
+                              std::vector<cv::Point2f>& prev_matched,
+                              std::vector<int>& matches12, float window) const;
+
   static float RadiusByViewingCos(float view_cos) { return view_cos > 0.998f ? 2.5f : 4.0f; }
 
  private:

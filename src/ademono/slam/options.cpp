@@ -63,6 +63,9 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
   using T = TrackingOptions;
   static const auto table =
       OptionsTable<T>("tracking")
+          .Add("monocular", &T::monocular)
+          .Add("init_min_matches", &T::init_min_matches, Range::AtLeast(8))
+          .Add("init_search_radius", &T::init_search_radius, Range::Above(0))
           .Add("min_init_points", &T::min_init_points, Range::AtLeast(10))
           .Add("motion_search_radius", &T::motion_search_radius, Range::Above(0))
           .Add("min_motion_matches", &T::min_motion_matches, Range::Above(0))
@@ -124,6 +127,10 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
           .Add("triangulation_min_parallax_deg", &M::triangulation_min_parallax_deg,
                Range::ClosedOpen(0, 90))
           .Add("triangulation_depth_sigmas", &M::triangulation_depth_sigmas, Range::AtLeast(0))
+          .Add("triangulation_match_ratio", &M::triangulation_match_ratio,
+               Range::OpenClosed(0, 1))
+          .Add("triangulation_min_baseline_ratio", &M::triangulation_min_baseline_ratio,
+               Range::AtLeast(0))
           .AddFlat(&M::ba, BundleAdjustmentOptions::Table());
   return table;
 }
@@ -183,7 +190,9 @@ const OptionsTable<SystemOptions>& SystemOptions::Table() {
                                 .AddSection("mapping", &S::mapping, MappingOptions::Table())
                                 .AddSection("optimizer", &S::pose, PoseOptimizerOptions::Table())
                                 .AddSection("place", &S::place, KeyFrameDatabaseOptions::Table())
-                                .AddSection("loop", &S::loop, LoopOptions::Table());
+                                .AddSection("loop", &S::loop, LoopOptions::Table())
+                                .AddSection("initializer", &S::initializer,
+                                            TwoViewOptions::Table());
   return table;
 }
 
@@ -196,6 +205,7 @@ void SystemOptions::Check() const {
   pose.Check();
   place.Check();
   loop.Check();
+  initializer.Check();
 }
 
 SystemOptions SystemOptions::FromYaml(const YAML::Node& root, const std::filesystem::path& path) {

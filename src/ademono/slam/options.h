@@ -16,6 +16,7 @@
 #include "ademono/perception/detector_options.h"
 #include "ademono/feature/orb_extractor.h"
 #include "ademono/filter/feature_filter.h"
+#include "ademono/initializer/two_view.h"
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/place/keyframe_database.h"
@@ -91,6 +92,14 @@ struct FrameDepthOptions {
 };
 
 struct TrackingOptions {
+  // The monocular core (docs/slam.md): map points come from triangulation between keyframes and
+  // the pose from 2-dof reprojection residuals alone. Without depth the map starts from a
+  // two-view initialisation (initializer/two_view) and has no metric scale; with a network's
+  // depth the first frame's depths seed the map, and after that the depths only measure the
+  // scale and hold the points geometry cannot place yet (low parallax) as priors.
+  bool monocular = false;
+  int init_min_matches = 100;        // two-view: matches with the reference frame to go on
+  double init_search_radius = 100;   // two-view: px around the last matched position
   int min_init_points = 500;         // points with depth needed to initialise the map
   double motion_search_radius = 15;  // px at level 0 for the constant-velocity search
   int min_motion_matches = 20;       // below this the window is doubled and searched again
@@ -174,6 +183,13 @@ struct MappingOptions {
   int triangulation_neighbours = 10;
   double triangulation_min_parallax_deg = 1.0;
   double triangulation_depth_sigmas = 3.0;
+  // Ratio test of the epipolar search (best / second-best Hamming distance among the candidates
+  // along the epipolar band; 1 disables it).
+  double triangulation_match_ratio = 0.6;
+  // A covisible keyframe is triangulated with only when the baseline is at least this fraction
+  // of its median scene depth (ORB-SLAM's 0.01); the monocular core makes no keyframe (unless
+  // tracking is weak) before the frame is that far from its reference keyframe.
+  double triangulation_min_baseline_ratio = 0.01;
   BundleAdjustmentOptions ba;  // keys ba_first_iterations, ba_second_iterations
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);
@@ -229,6 +245,7 @@ struct SystemOptions {
   PoseOptimizerOptions pose;  // the `optimizer:` node
   KeyFrameDatabaseOptions place;  // place recognition index (relocalisation, loops)
   LoopOptions loop;
+  TwoViewOptions initializer;  // the monocular two-view initialisation
   void Check() const;
   // Reads every sub-node of a config file's root. InputError "path: ..." on any problem, also for
   // an unknown key in `detector:` (DetectorOptions, read by the caller) and an unknown section.

@@ -61,7 +61,10 @@ const char* PoseQualityName(PoseQuality quality) {
 }
 
 Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOptions& options)
-    : map_(map), local_mapping_(local_mapping), options_(options) {}
+    : map_(map),
+      local_mapping_(local_mapping),
+      options_(options),
+      monocular_initialization_(options) {}
 
 void Tracking::StartInLoadedMap(bool localize_only) {
   map_loaded_ = true;
@@ -130,7 +133,12 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         ground_heights_.push_back(*height * factor);
       }
     }
-    ok = Initialise(frame, Rigid3d::Identity());
+    if (options_.tracking.monocular &&
+        CountDepthPoints(frame) < options_.tracking.min_init_points) {
+      ok = InitialiseMonocular(frame);
+    } else {
+      ok = Initialise(frame, Rigid3d::Identity());
+    }
     if (ok) out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
   } else {
     // Fusion in local mapping may have replaced points the last frame still holds.
@@ -310,6 +318,8 @@ void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
                                    frame.id);
   if (options_.tracking.static_test) point->static_probability = static_probability;
   point->admitted = UsableForPose(*point);
+  // The monocular core keeps a depth-made point's depth only as a prior (local mapping).
+  point->depth_prior = options_.tracking.monocular;
   point->AddObservation(&keyframe, i);
   keyframe.AddMapPoint(point, i);
   point->ComputeDistinctiveDescriptor();
@@ -336,6 +346,24 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   local_keyframes_ = {kf.get()};
   local_points_.clear();
   for (const auto& p : kf->map_points) {
+    if (p) local_points_.push_back(p);
+  }
+  velocity_.reset();
+  state_ = TrackingState::kOk;
+  matches_inliers_ = static_cast<int>(local_points_.size());
+  return true;
+}
+
+bool Tracking::InitialiseMonocular(Frame& frame) {
+  const std::optional<MonocularInitialization::Keyframes> keyframes =
+      monocular_initialization_.Add(frame, map_);
+  if (!keyframes) return false;
+  frame.reference_keyframe = keyframes->second.get();
+  reference_keyframe_ = keyframes->second.get();
+  last_keyframe_frame_id_ = frame.id;
+  local_keyframes_ = {keyframes->first.get(), keyframes->second.get()};
+  local_points_.clear();
+  for (const auto& p : keyframes->second->map_points) {
     if (p) local_points_.push_back(p);
   }
   velocity_.reset();
@@ -826,7 +854,8 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   }
   const bool mapped_place = t.mapped_place_ratio > 0 && tracked_close > 0 &&
                             established_close > t.mapped_place_ratio * tracked_close;
-  const bool need_close = tracked_close < t.close_tracked_min &&
+  // Monocular: close points are no measurement of structure (ORB-SLAM's monocular rule).
+  const bool need_close = !t.monocular && tracked_close < t.close_tracked_min &&
                           untracked_close > t.close_untracked_min && !mapped_place;
   const double ratio = map_.NumKeyFrames() < 2 ? 0.4 : t.keyframe_ref_ratio;
   const uint64_t since_kf = frame.id - last_keyframe_frame_id_;
@@ -834,6 +863,8 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   const bool c1b = since_kf >= static_cast<uint64_t>(t.min_frames_between_keyframes) && idle;
   const bool weak = matches_inliers_ < ref_matches * 0.25;
   if (!weak && since_kf < static_cast<uint64_t>(t.min_keyframe_spacing)) return false;
+  // Monocular: a keyframe is for new structure, which needs a baseline to triangulate with.
+  if (t.monocular && !weak && !HasTriangulationBaseline(frame)) return false;
   const bool c1c = weak || need_close;
   const bool c2 = (matches_inliers_ < ref_matches * ratio || need_close) && matches_inliers_ > 15;
   spdlog::debug(
@@ -853,6 +884,19 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   return insert;
 }
 
+bool Tracking::HasTriangulationBaseline(const Frame& frame) const {
+  if (reference_keyframe_ == nullptr || !frame.cam_from_world) return true;
+  std::vector<double> depths;
+  for (size_t i = 0; i < frame.map_points.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (p && !p->bad && !frame.outlier[i]) depths.push_back((*frame.cam_from_world * p->position).z());
+  }
+  const double median_depth = Median(depths);
+  if (!(median_depth > 0)) return true;
+  const double baseline = (frame.CameraCenter() - reference_keyframe_->CameraCenter()).norm();
+  return baseline >= options_.mapping.triangulation_min_baseline_ratio * median_depth;
+}
+
 std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
     Frame& frame, std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>* created) {
   std::shared_ptr<KeyFrame> kf = map_.CreateKeyFrame(frame);
@@ -864,7 +908,7 @@ std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(
   // New points from depth: all close ones, and at least the nearest `new_keyframe_min_points`.
   const FrameFeatures& f = frame.F();
   std::vector<std::pair<float, size_t>> by_depth;
-  for (size_t i = 0; i < f.Size(); ++i) {
+  for (size_t i = 0; i < f.Size() && KeyFramePointsFromDepth(); ++i) {
     if (f.depth[i] > 0) by_depth.emplace_back(f.depth[i], i);
   }
   std::sort(by_depth.begin(), by_depth.end());

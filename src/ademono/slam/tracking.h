@@ -16,6 +16,7 @@
 #include "ademono/slam/frame.h"
 #include "ademono/slam/local_mapping.h"
 #include "ademono/slam/map.h"
+#include "ademono/slam/monocular_initialization.h"
 #include "ademono/slam/options.h"
 
 namespace ademono {
@@ -118,11 +119,19 @@ class Tracking {
 
  private:
   bool Initialise(Frame& frame, const Rigid3d& cam_from_world) ADEMONO_REQUIRES(map_.mutex);
+  // Monocular without depth: the two-view initialisation (MonocularInitialization).
+  bool InitialiseMonocular(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // Whether a new keyframe makes map points from its own depths: always with sensor-like depth;
+  // in the monocular core never (its points come from triangulation in local mapping).
+  bool KeyFramePointsFromDepth() const { return !options_.tracking.monocular; }
   bool TrackWithMotionModel(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool TrackReferenceKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool TrackLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool Relocalise(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool NeedNewKeyFrame(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
+  // Monocular: the frame is far enough from its reference keyframe for new points to be
+  // triangulated (mapping.triangulation_min_baseline_ratio of its median scene depth).
+  bool HasTriangulationBaseline(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
   // `created`: the points made from the frame's own depth (TrackingOutput::created_points).
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(
       Frame& frame, std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>>* created)
@@ -205,6 +214,7 @@ class Tracking {
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
   std::vector<FrameRecord> records_;
+  MonocularInitialization monocular_initialization_;
 };
 
 }  // namespace ademono

@@ -1,0 +1,108 @@
+#include "ademono/optimize/network_depth_model.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "ademono/core/statistics.h"
+
+namespace ademono {
+namespace {
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+double RobustSigma(const std::vector<double>& residuals) {
+  std::vector<double> abs;
+  abs.reserve(residuals.size());
+  for (double r : residuals) abs.push_back(std::abs(r));
+  return 1.4826 * Median(abs);
+}
+
+}  // namespace
+
+InverseDepthAffine FitInverseDepthAffine(const std::vector<double>& map_depths,
+                                         const std::vector<double>& network_depths,
+                                         const InverseDepthAffineOptions& options) {
+  InverseDepthAffine fit;
+  std::vector<double> zm, zn, ratios, inverse;
+  for (size_t i = 0; i < std::min(map_depths.size(), network_depths.size()); ++i) {
+    const double m = map_depths[i], n = network_depths[i];
+    if (!(m > 0) || !(n > 0) || !std::isfinite(m) || !std::isfinite(n)) continue;
+    zm.push_back(m);
+    zn.push_back(n);
+    ratios.push_back(n / m);
+    inverse.push_back(1.0 / n);
+  }
+  fit.num_points = static_cast<int>(zm.size());
+  if (fit.num_points < options.min_points) return fit;
+  fit.median_ratio = Median(ratios);
+  fit.a = fit.median_ratio;  // 1 / z_map = a / z_net at the median
+  fit.b = 0.0;
+  const double low = Quantile(inverse, 0.1), high = Quantile(inverse, 0.9);
+  fit.scale_only = !(low > 0) || high / low < options.min_inverse_depth_span;
+
+  const size_t n = zm.size();
+  std::vector<double> residuals(n);
+  auto compute_residuals = [&]() {
+    for (size_t i = 0; i < n; ++i) residuals[i] = 1.0 - zm[i] * (fit.a / zn[i] + fit.b);
+  };
+  compute_residuals();
+  for (int it = 0; it < options.iterations; ++it) {
+    const double sigma = std::max(RobustSigma(residuals), 1e-6);
+    // Huber first (convex: settles near the bulk), then Tukey's biweight, which gives points far
+    // off (wrong matches, movers) no weight at all.
+    const bool tukey = it >= 3;
+    const double k = (tukey ? 4.685 : options.huber_sigmas) * sigma;
+    // Weighted normal equations of r_i = 1 - a x_i - b y_i, x_i = z_map / z_net, y_i = z_map.
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d g = Eigen::Vector2d::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const double r = std::abs(residuals[i]);
+      double w = 0.0;
+      if (tukey) {
+        w = r < k ? std::pow(1.0 - (r / k) * (r / k), 2) : 0.0;
+      } else {
+        w = r <= k ? 1.0 : k / r;
+      }
+      const Eigen::Vector2d j(zm[i] / zn[i], zm[i]);
+      A += w * j * j.transpose();
+      g += w * j;
+    }
+    double a = fit.a, b = 0.0;
+    if (fit.scale_only) {
+      if (!(A(0, 0) > 0)) break;
+      a = g(0) / A(0, 0);
+    } else {
+      const Eigen::Vector2d x = A.ldlt().solve(g);
+      if (!x.allFinite()) break;
+      a = x(0);
+      b = x(1);
+    }
+    const bool converged = std::abs(a - fit.a) <= 1e-12 * std::abs(fit.a) &&
+                           std::abs(b - fit.b) <= 1e-12 * (std::abs(fit.b) + std::abs(a));
+    fit.a = a;
+    fit.b = b;
+    compute_residuals();
+    if (converged && tukey) break;
+  }
+  if (!(fit.a > 0) || !std::isfinite(fit.a) || !std::isfinite(fit.b)) return fit;
+  // The spread of the points the fit kept (within 3 robust sigmas).
+  std::vector<double> log_residuals;
+  const double sigma = RobustSigma(residuals);
+  for (size_t i = 0; i < n; ++i) {
+    if (std::abs(residuals[i]) > 3.0 * sigma) continue;
+    ++fit.num_inliers;
+    const double mapped = fit.Map(zn[i]);
+    if (mapped > 0) log_residuals.push_back(std::log(zm[i] / mapped));
+  }
+  fit.sigma_log = RobustSigma(log_residuals);
+  fit.valid = true;
+  return fit;
+}
+
+}  // namespace ademono
