@@ -29,14 +29,14 @@ function connect(wsUrl) {
 }
 
 // Sends `payload` and waits until the server answered with a status error or closed.
-async function expectRejected(wsUrl, name, send) {
+async function expectRejected(wsUrl, name, send, { untilClosed } = {}) {
   const conn = await connect(wsUrl);
   const before = conn.statuses.length;
   send(conn.ws);
   const deadline = Date.now() + 5000;
   while (Date.now() < deadline) {
     if (conn.closed !== null) return { name, outcome: 'closed ' + conn.closed };
-    if (conn.statuses.slice(before).some((s) => s.level === 2)) {
+    if (!untilClosed && conn.statuses.slice(before).some((s) => s.level === 2)) {
       conn.ws.close();
       return { name, outcome: 'status error: ' + conn.statuses[before].message };
     }
@@ -122,13 +122,16 @@ async function main() {
     ['oversized text (1 MiB)', (ws) => ws.send('{"op": "subscribe", "pad": "' + 'x'.repeat(1 << 20) + '"}')],
     ['oversized binary (4 MiB)', (ws) => ws.send(Buffer.alloc(4 << 20, 0x41))],
     ['invalid UTF-8', (ws) => ws.send(Buffer.from([0x7b, 0xc3, 0x28, 0x7d]), { binary: false })],
-    ['flood of bad messages', (ws) => { for (let i = 0; i < 200; i++) ws.send('nonsense ' + i); }],
+    ['flood of bad messages', (ws) => { for (let i = 0; i < 200; i++) ws.send('nonsense ' + i); },
+      { untilClosed: true }],
   ];
   const outcomes = [];
-  for (const [name, send] of cases) outcomes.push(await expectRejected(wsUrl, name, send));
+  for (const [name, send, options] of cases) outcomes.push(await expectRejected(wsUrl, name, send, options));
   for (const o of outcomes) t.check(o.outcome !== null, o.name + ': neither a status error nor a close');
   const byName = Object.fromEntries(outcomes.map((o) => [o.name, o.outcome]));
-  t.check(/^closed 1009/.test(byName['oversized text (1 MiB)'] || ''), 'oversized text closes with 1009: ' + byName['oversized text (1 MiB)']);
+  // The server answers close 1009; while the client is still sending the rest of the megabyte,
+  // the kernel may reset the connection before the client reads that frame (1006).
+  t.check(/^closed (1009|1006)/.test(byName['oversized text (1 MiB)'] || ''), 'oversized text closes the connection: ' + byName['oversized text (1 MiB)']);
   t.check(/^closed/.test(byName['flood of bad messages'] || ''), 'a flood closes the connection: ' + byName['flood of bad messages']);
   // A stalled client (subscribed, never reads) and one that leaves abruptly mid-run.
   const stalled = await connect(wsUrl);
