@@ -27,12 +27,21 @@ import report_browser  # noqa: E402
 
 CLI = os.environ.get("ADEMONO_CLI", os.path.join(ROOT, "build", "release", "bin", "ademono"))
 SHARED = os.environ.get("ADEMONO_SHARED_DIR", os.path.join(os.path.dirname(ROOT), "shared"))
-# The brief's flags for a test browser, on top of report_browser's (which has the fresh profile).
+# No GPU process, on top of report_browser's flags (which have the fresh profile). WebGL then
+# composites in software: Chromium warns once per page that reading the canvas back stalls,
+# a performance note of its GL driver and nothing the page did (see significant()).
 EXTRA_FLAGS = ["--disable-gpu"]
+GL_PERFORMANCE_NOTE = "GL Driver Message (OpenGL, Performance"
+
+
+def significant(console):
+    """The console lines that matter: everything but the software-compositing performance note."""
+    return [line for line in console
+            if not (line.startswith("log.warning: ") and GL_PERFORMANCE_NOTE in line)]
 
 
 def run_and_capture(png, dataset=None, frames="0:200", depth="sensor", port=0, width=1280,
-                    height=1000, out=None, timeout=240):
+                    height=1300, out=None, timeout=240):
     dataset = dataset or "7scenes:" + os.path.join(SHARED, "data", "7scenes-seq-a")
     tmp = None
     if out is None:
@@ -94,13 +103,13 @@ def main():
     p.add_argument("--depth", default="sensor")
     p.add_argument("--port", type=int, default=0)
     p.add_argument("--width", type=int, default=1280)
-    p.add_argument("--height", type=int, default=1000)
+    p.add_argument("--height", type=int, default=1300)
     a = p.parse_args()
     r = run_and_capture(a.png, a.dataset, a.frames, a.depth, a.port, a.width, a.height)
     print(json.dumps({"console": r["console"], "ready": r["ready"], "errors": r["errors"],
                       "states": r["states"], "exit_code": r["exit_code"],
                       "live": r["summary"].get("live")}, indent=1))
-    return 0 if r["ready"] == "1" and not r["console"] and r["exit_code"] == 0 else 1
+    return 0 if r["ready"] == "1" and not significant(r["console"]) and r["exit_code"] == 0 else 1
 
 
 if __name__ == "__main__":

@@ -30,7 +30,8 @@ def test_live_page_draws_the_run(tmp_path):
     port = int(os.environ.get("ADEMONO_LIVE_PORT", "0"))
     r = live_browser.run_and_capture(png, port=port, out=str(tmp_path / "run"))
     assert r["exit_code"] == 0, r["stderr"]
-    assert r["console"] == [], "console output: %s" % r["console"]
+    assert live_browser.significant(r["console"]) == [], "console output: %s" % r["console"]
+    assert not any("error" in line.split(":")[0] for line in r["console"]), r["console"]
     assert r["errors"] is None
     assert r["ready"] == "1", r["states"]
     # Open during the run: it saw frames arrive before the run finished.

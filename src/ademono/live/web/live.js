@@ -44,7 +44,9 @@
   }
   const canvas = $('view3d');
   const dpr = window.devicePixelRatio || 1;
-  const regl = createREGL({ canvas: canvas, attributes: { antialias: true, preserveDrawingBuffer: true } });
+  // No preserveDrawingBuffer: the page redraws often, and a preserved buffer makes SwiftShader
+  // read the pixels back for every frame (a console warning per redraw).
+  const regl = createREGL({ canvas: canvas, attributes: { antialias: true, preserveDrawingBuffer: false } });
   const vert = 'precision mediump float; attribute vec3 position; attribute vec3 color; uniform mat4 proj, view; uniform float size; varying vec3 vColor;' +
     'void main() { vColor = color; gl_Position = proj * view * vec4(position, 1.0); gl_PointSize = size; }';
   const frag = 'precision mediump float; varying vec3 vColor; void main() { gl_FragColor = vec4(vColor, 1.0); }';
@@ -166,6 +168,7 @@
     ms: plot('plot-ms', ['extraction', 'filter', 'tracking', 'local mapping'], ['#868e96', '#fab005', '#ff922b', '#69db7c'], 'ms'),
     scale: plot('plot-scale', ['depth scale'], ['#5f3dc4'], 'factor'),
   };
+  let scaleSeen = false;
   function drawPlots() {
     const s = series;
     plots.points.setData([s.frame, s.keypoints, s.kept, s.inliers]);
@@ -259,6 +262,7 @@
       push('frame', m.frame); push('keypoints', m.keypoints); push('kept', m.kept); push('inliers', m.inliers);
       push('extraction', m.ms.extraction); push('filter', m.ms.filter); push('tracking', m.ms.tracking); push('mapping', m.ms.mapping);
       push('scale', m.depth_scale);
+      if (m.depth_scale !== null && !scaleSeen) { scaleSeen = true; $('scale-note').hidden = true; }
       dirtyPlots = true;
     },
     '/ademono/run': (m) => {
