@@ -306,5 +306,5 @@ def test_system_serves_the_live_view(tmp_path):
     assert stats["url"] == url and stats["clients"] == 1
     with pytest.raises(RuntimeError):
         ademono.System(None, seq.camera).live_url
-    with pytest.raises(Exception, match="HOST:PORT"):
+    with pytest.raises(Exception, match=r"expected \[HOST:\]PORT"):
         ademono.System(None, seq.camera, live="nowhere:port")

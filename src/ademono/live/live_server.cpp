@@ -474,7 +474,7 @@ void LiveServer::Impl::Start() {
     address = net::ip::make_address("127.0.0.1");
   } else {
     address = net::ip::make_address(options.host, ec);
-    if (ec) throw InputError("--live: '" + options.host + "' is not an IP address");
+    if (ec) throw InputError("live address: '" + options.host + "' is not an IP address");
   }
   const tcp::endpoint where(address, options.port);
   acceptor.open(where.protocol(), ec);
@@ -482,7 +482,7 @@ void LiveServer::Impl::Start() {
   if (!ec) acceptor.bind(where, ec);
   if (!ec) acceptor.listen(net::socket_base::max_listen_connections, ec);
   if (ec) {
-    throw InputError("--live: cannot listen on " + options.host + ":" +
+    throw InputError("live view: cannot listen on " + options.host + ":" +
                      std::to_string(options.port) + ": " + ec.message());
   }
   endpoint = acceptor.local_endpoint();
@@ -615,25 +615,25 @@ LiveOptions ParseLiveAddress(const std::string& text) {
   std::smatch m;
   LiveOptions o;
   if (!std::regex_match(text, m, kPattern))
-    throw InputError("--live '" + text + "': expected [HOST:]PORT, e.g. 8765 or 127.0.0.1:8765");
+    throw InputError("live address '" + text + "': expected [HOST:]PORT, e.g. 8765 or 127.0.0.1:8765");
   if (m[1].matched) {
     std::string host = m[1].str();
     if (host.front() == '[') host = host.substr(1, host.size() - 2);
     beast::error_code ec;
     if (host != "localhost") {
       net::ip::make_address(host, ec);
-      if (ec) throw InputError("--live '" + text + "': '" + host + "' is not an IP address");
+      if (ec) throw InputError("live address '" + text + "': '" + host + "' is not an IP address");
     }
     o.host = host;
   }
   const long port = std::stol(m[2].str());
-  if (port > 65535) throw InputError("--live '" + text + "': port above 65535");
+  if (port > 65535) throw InputError("live address '" + text + "': port above 65535");
   o.port = static_cast<uint16_t>(port);
   return o;
 }
 
 LiveServer::LiveServer(const LiveOptions& options) : impl_(std::make_shared<Impl>(options)) {
-  if (!(options.image_hz > 0)) throw InputError("--live: image rate must be positive");
+  if (!(options.image_hz > 0)) throw InputError("live view: the image rate must be positive");
   impl_->Start();
 }
 
