@@ -53,7 +53,8 @@ struct RunArgs : SequenceRunArgs {
   std::string live;  // [HOST:]PORT of the live view
   size_t live_wait_clients = 0;
   double live_linger = 0;
-  double live_image_hz = 15;
+  double live_image_hz = 10;
+  double live_map_hz = 2;
 };
 
 // SIGINT / SIGTERM: finish the current frame, then write the outputs of the frames done so far
@@ -148,6 +149,7 @@ int Run(const RunArgs& args) {
   if (!args.live.empty()) {
     live_options = live::ParseLiveAddress(args.live);
     live_options->image_hz = args.live_image_hz;
+    live_options->map_hz = args.live_map_hz;
   }
   CheckOutputFolder(args.out, args.overwrite);
   std::optional<fs::path> camera_yaml;
@@ -338,6 +340,11 @@ const bool kRegistered = RegisterCommand(
           ->check(CLI::Range(0.0, 86400.0));
       app.add_option("--live-image-hz", args->live_image_hz,
                      "with --live, send the camera image at most this often")
+          ->check(CLI::Range(0.1, 1000.0))
+          ->capture_default_str();
+      app.add_option("--live-map-hz", args->live_map_hz,
+                     "with --live, send the map (cloud, trajectory, scene) at most this often "
+                     "while it changes (the final map always)")
           ->check(CLI::Range(0.1, 1000.0))
           ->capture_default_str();
       return [args] { return Run(*args); };

@@ -1,7 +1,8 @@
-// Shared by the live view's Node tests: start `ademono run --live`, find its port, read the run's
+// Shared by the live view's Node tests (and tools/bench_live.js): start `ademono run --live`, find its port, read the run's
 // outputs. Environment: ADEMONO_CLI (the binary), ADEMONO_SHARED_DIR (../shared), ADEMONO_NODE_MODULES
 // (.deps/foxglove/node_modules, scripts/setup.sh), ADEMONO_LIVE_PORT (optional: a port of the
-// caller's choosing; default 0, any free port, read back from the run's stderr).
+// caller's choosing; default 0, any free port, read back from the run's stderr),
+// ADEMONO_LIVE_FRAMES (default 0:200).
 'use strict';
 const assert = require('assert');
 const childProcess = require('child_process');
@@ -14,7 +15,6 @@ const CLI = process.env.ADEMONO_CLI || path.join(ROOT, 'build', 'release', 'bin'
 const SHARED = process.env.ADEMONO_SHARED_DIR || path.resolve(ROOT, '..', 'shared');
 const NODE_MODULES = process.env.ADEMONO_NODE_MODULES || path.join(ROOT, '.deps', 'foxglove', 'node_modules');
 const DATASET = '7scenes:' + path.join(SHARED, 'data', '7scenes-seq-a');
-const FRAMES = process.env.ADEMONO_LIVE_FRAMES || '0:200';
 
 function need(name) {
   return require(path.join(NODE_MODULES, name));
@@ -33,7 +33,8 @@ function tempDir(name) {
 
 // The run's base arguments: 200 frames of seq-a with sensor depth.
 function runArgs(out) {
-  return ['run', '--dataset', DATASET, '--depth', 'sensor', '--frames', FRAMES, '--out', out];
+  const frames = process.env.ADEMONO_LIVE_FRAMES || '0:200';
+  return ['run', '--dataset', DATASET, '--depth', 'sensor', '--frames', frames, '--out', out];
 }
 
 // Runs to the end without a live view; resolves to the output folder.

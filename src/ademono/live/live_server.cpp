@@ -123,7 +123,7 @@ class LiveServer::Impl : public std::enable_shared_from_this<LiveServer::Impl> {
   std::array<std::atomic<int>, kNumChannels + 1> subscribers{};
   std::atomic<size_t> connected{0}, ready{0};
   std::atomic<bool> map_refresh{false};
-  std::atomic<int64_t> next_image_ns{0};
+  std::atomic<int64_t> next_image_ns{0}, next_map_ns{0};
   std::atomic<bool> ended{false}, flushed_after_end{false};
   std::atomic<uint64_t> accepted{0}, sent{0}, dropped{0}, skipped{0}, errors{0}, bytes{0};
   std::mutex inbox_mutex;
@@ -633,7 +633,8 @@ LiveOptions ParseLiveAddress(const std::string& text) {
 }
 
 LiveServer::LiveServer(const LiveOptions& options) : impl_(std::make_shared<Impl>(options)) {
-  if (!(options.image_hz > 0)) throw InputError("live view: the image rate must be positive");
+  if (!(options.image_hz > 0) || !(options.map_hz > 0))
+    throw InputError("live view: the image and map rates must be positive");
   impl_->Start();
 }
 
@@ -723,11 +724,25 @@ bool LiveServer::WantsImages() const {
   return now >= impl_->next_image_ns.load();
 }
 
+namespace {
+int64_t NowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
 bool LiveServer::WantsMapSnapshot(bool map_changed) {
   const bool watched = impl_->Subscribed(Channel::kMap) || impl_->Subscribed(Channel::kTrajectory) ||
                        impl_->Subscribed(Channel::kScene);
-  const bool refresh = impl_->map_refresh.exchange(false);
-  return watched && (map_changed || refresh);
+  if (!watched) return false;
+  const int64_t now = NowNs();
+  // A new subscriber gets a fresh snapshot at once; changes at most map_hz.
+  if (impl_->map_refresh.exchange(false) ||
+      (map_changed && now >= impl_->next_map_ns.load())) {
+    impl_->next_map_ns = now + static_cast<int64_t>(1e9 / impl_->options.map_hz);
+    return true;
+  }
+  return false;
 }
 
 void LiveServer::OnFrame(LiveFrame frame) {

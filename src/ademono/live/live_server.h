@@ -11,7 +11,7 @@
 // - each client has one pending message per channel: a client that reads slower than the run
 //   gets the newest message of each channel, the ones it replaced are dropped (messages_dropped);
 // - JPEG encoding and JSON happen on the server thread, images only while someone subscribes to
-//   them, at most `image_hz` per second;
+//   them, at most `image_hz` per second, map snapshots at most `map_hz`;
 // - a client that sends malformed, oversized or out-of-order messages gets a status error, and
 //   is disconnected after `max_client_errors` of them (oversized: at once, close code 1009).
 
@@ -28,7 +28,10 @@ namespace ademono::live {
 struct LiveOptions {
   std::string host = "127.0.0.1";  // another address only by the user's explicit choice
   uint16_t port = 8765;            // 0: any free port (Port() tells which)
-  double image_hz = 15;            // images and their annotations at most this often (wall)
+  double image_hz = 10;            // images and their annotations at most this often (wall)
+  // Map snapshots (cloud, trajectory, scene) at most this often while the run goes on; the final
+  // one always. Encoding and parsing a cloud is the view's largest cost.
+  double map_hz = 2;
   int jpeg_quality = 80;
   size_t max_clients = 16;
   size_t max_client_message = 64 * 1024;  // bytes; larger client messages close the connection
