@@ -37,18 +37,32 @@ function runArgs(out) {
   return ['run', '--dataset', DATASET, '--depth', 'sensor', '--frames', frames, '--out', out];
 }
 
-// Runs to the end without a live view; resolves to the output folder.
-function runPlain(out) {
-  const r = childProcess.spawnSync(CLI, runArgs(out), { encoding: 'utf8', timeout: 300000 });
+// With { timed: true } the run goes through /usr/bin/time, whose last stderr line is
+// "CPU USER SYS" (seconds of the whole process): see cpuSeconds().
+function command(args, options) {
+  if (options && options.timed) return ['/usr/bin/time', ['-f', 'CPU %U %S', CLI].concat(args)];
+  return [CLI, args];
+}
+function cpuSeconds(stderr) {
+  const m = /CPU ([0-9.]+) ([0-9.]+)\s*$/.exec(stderr);
+  return m ? Number(m[1]) + Number(m[2]) : null;
+}
+
+// Runs to the end without a live view; returns the output folder (and with { timed: true },
+// {out, cpu}).
+function runPlain(out, options) {
+  const [cmd, args] = command(runArgs(out), options);
+  const r = childProcess.spawnSync(cmd, args, { encoding: 'utf8', timeout: 600000 });
   assert.strictEqual(r.status, 0, 'plain run failed: ' + r.stderr);
-  return out;
+  return options && options.timed ? { out, cpu: cpuSeconds(r.stderr) } : out;
 }
 
 // Starts a run with --live and `extra` options; returns {proc, url, wsUrl, exited}. `url`
 // resolves once the run has printed where it serves.
-function startLive(out, extra) {
-  const args = runArgs(out).concat(['--live', '127.0.0.1:' + port()], extra || []);
-  const proc = childProcess.spawn(CLI, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+function startLive(out, extra, options) {
+  const [cmd, args] = command(runArgs(out).concat(['--live', '127.0.0.1:' + port()], extra || []),
+    options);
+  const proc = childProcess.spawn(cmd, args, { stdio: ['ignore', 'pipe', 'pipe'] });
   let stderr = '';
   let stdout = '';
   proc.stdout.on('data', (d) => { stdout += d; });
@@ -105,5 +119,5 @@ class Checks {
 
 module.exports = {
   CLI, SHARED, need, tempDir, runArgs, runPlain, startLive, withTimeout, readTum, plyVertexCount,
-  sameFile, Checks, path, fs,
+  sameFile, Checks, path, fs, cpuSeconds,
 };
