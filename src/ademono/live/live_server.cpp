@@ -697,9 +697,10 @@ void LiveServer::Stop() {
   impl_->thread.join();
   // The aborted operations' handlers hold the sessions and impl itself: run them out here, so
   // nothing is left in the io_context (no reference cycle through it).
-  impl_->ioc.restart();
-  while (impl_->ioc.poll() > 0) {
-  }
+  // (The thread may have ended before the abort above ran, which then stops a poll: restart.)
+  do {
+    impl_->ioc.restart();
+  } while (impl_->ioc.poll() > 0);
   impl_->sessions.clear();
   impl_->all_sessions.clear();
 }
