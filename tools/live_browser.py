@@ -3,7 +3,7 @@
 until the run has finished and the page has drawn its final state, takes a screenshot.
 
     tools/live_browser.py SHOT.png [--dataset KIND:PATH] [--frames A:B] [--depth sensor]
-                          [--port N] [--width 1280] [--height 1000]
+                          [--port N] [--width 1280] [--height 1300] [--crop HEIGHT]
 
 Prints the page's console lines, its states seen while polling and the run's summary.json "live"
 block as JSON. Used by tests/live/live_browser_test.py and for the README's picture (with the
@@ -104,8 +104,13 @@ def main():
     p.add_argument("--port", type=int, default=0)
     p.add_argument("--width", type=int, default=1280)
     p.add_argument("--height", type=int, default=1300)
+    p.add_argument("--crop", type=int, help="keep only the top HEIGHT pixels of the screenshot")
     a = p.parse_args()
     r = run_and_capture(a.png, a.dataset, a.frames, a.depth, a.port, a.width, a.height)
+    if a.crop:
+        import cv2  # python3-opencv
+        image = cv2.imread(a.png)
+        cv2.imwrite(a.png, image[:a.crop], [cv2.IMWRITE_PNG_COMPRESSION, 9])
     print(json.dumps({"console": r["console"], "ready": r["ready"], "errors": r["errors"],
                       "states": r["states"], "exit_code": r["exit_code"],
                       "live": r["summary"].get("live")}, indent=1))
