@@ -8,7 +8,9 @@
 // - the last /map point cloud has map.ply's point count, the last /scene keyframes.tum's
 //   keyframes, the final /ademono/run status the run's counts;
 // - images are JPEG, frames arrive in order, summary.json counts the live view's messages.
-//   node tests/live/live_client_test.js [--port N]      (default: any free port)
+//   node tests/live/live_client_test.js [--port N] [--realtime]   (default: any free port)
+// --realtime: the same with `--realtime --realtime-speed 2` (frames the run has no time for are
+// dropped; the checks hold for the frames it took).
 'use strict';
 const c = require('./live_common');
 
@@ -31,7 +33,8 @@ const REQUIRED = {
 async function main() {
   const t = new c.Checks();
   const out = c.tempDir('client');
-  const run = c.startLive(out, ['--live-wait-clients', '1', '--live-linger', '20']);
+  const realtime = process.argv.includes('--realtime') ? ['--realtime', '--realtime-speed', '2'] : [];
+  const run = c.startLive(out, ['--live-wait-clients', '1', '--live-linger', '20'].concat(realtime));
   const wsUrl = await c.withTimeout(run.wsUrl, 60000, 'the run to start serving');
 
   const ajv = new Ajv({ strict: false, allErrors: false });
