@@ -13,7 +13,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <regex>
-#include <set>
 #include <thread>
 
 #include "ademono/core/error.h"
