@@ -6,7 +6,8 @@
 // excluded) and CPU seconds of the whole ademono process (/usr/bin/time: user + system, less
 // sensitive to other jobs on the machine than frames/s), their medians, and checks that every
 // run's trajectory.tum is the same.
-//   node tools/bench_live.js [--repeats 3] [--frames 0:600] [--out DIR]
+//   node tools/bench_live.js [--repeats 3] [--frames 0:600] [--out DIR] [--live-args "OPTIONS"]
+// --live-args: more `ademono run` options for the live runs, e.g. "--live-image-hz 1".
 // Needs ADEMONO_CLI (default build/release/bin/ademono) and the npm packages of
 // scripts/setup.sh (.deps/foxglove/node_modules).
 'use strict';
@@ -21,7 +22,8 @@ function option(name, fallback) {
 }
 
 async function liveRun(out) {
-  const run = c.startLive(out, ['--live-wait-clients', '1'], { timed: true });
+  const extra = option('--live-args', '').split(/\s+/).filter((a) => a);
+  const run = c.startLive(out, ['--live-wait-clients', '1'].concat(extra), { timed: true });
   const wsUrl = await c.withTimeout(run.wsUrl, 60000, 'serving');
   const client = new FoxgloveClient({ ws: new WebSocket(wsUrl, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
   let messages = 0;
