@@ -28,6 +28,8 @@
 #include "ademono/eval/trajectory_eval.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/live/live_server.h"
+#include "ademono/runner/live_feed.h"
 #include "ademono/slam/system.h"
 #include "ademono/synth/camera_motion.h"
 #include "ademono/synth/generator.h"
@@ -225,14 +227,28 @@ std::pair<YAML::Node, fs::path> ConfigNode(const py::object& config) {
 
 class PySystem {
  public:
-  PySystem(const py::object& config, const Camera& camera, std::optional<uint64_t> seed) {
+  PySystem(const py::object& config, const Camera& camera, std::optional<uint64_t> seed,
+           const std::optional<std::string>& live) {
     camera.Check();
     const auto [node, path] = ConfigNode(config);
     SystemOptions options = SystemOptions::FromYaml(node, path);
     if (seed) options.filter.seed = *seed;
     camera_ = camera;
     system_ = std::make_unique<System>(camera, options);
+    if (live) {
+      // The live view of `ademono run --live` (docs/live.md), fed after every track().
+      live_ = std::make_unique<live::LiveServer>(live::ParseLiveAddress(*live));
+      feed_ = std::make_unique<LiveFeed>(live_.get());
+    }
   }
+  ~PySystem() {
+    if (live_) {
+      py::gil_scoped_release release;
+      live_->Stop();
+    }
+  }
+  PySystem(const PySystem&) = delete;
+  PySystem& operator=(const PySystem&) = delete;
 
   PyTrackResult Track(const py::array& image, const std::optional<py::array>& depth,
                       std::optional<double> timestamp,
@@ -259,6 +275,7 @@ class PySystem {
     {
       py::gil_scoped_release release;
       r = system_->TrackFrame(frame, depth_m, boxes);
+      if (feed_) feed_->Frame(*system_, frame, boxes, r);
     }
     ++next_index_;
     PyTrackResult out;
@@ -284,13 +301,27 @@ class PySystem {
   void Shutdown() {
     py::gil_scoped_release release;
     system_->Shutdown();
+    if (feed_ && !ended_) {
+      // The final map and trajectory to the live view (as trajectory() and map_points() give).
+      ended_ = true;
+      feed_->End(*system_, {next_index_, static_cast<size_t>(system_->FrameTrajectory().size()),
+                            system_->NumKeyFrames(), system_->NumMapPoints(), system_->NumLost(),
+                            false});
+    }
   }
   System& Get() { return *system_; }
+  live::LiveServer& Live() {
+    if (!live_) throw std::runtime_error("this System was made without live=\"[HOST:]PORT\"");
+    return *live_;
+  }
 
  private:
   Camera camera_;
   std::unique_ptr<System> system_;
   size_t next_index_ = 0;
+  bool ended_ = false;
+  std::unique_ptr<live::LiveServer> live_;
+  std::unique_ptr<LiveFeed> feed_;
 };
 
 // ---- depth models and detectors ----
@@ -529,10 +560,37 @@ PYBIND11_MODULE(ademono, m) {
       .def_readonly("keypoints", &PyTrackResult::keypoints);
 
   py::class_<PySystem>(m, "System", "The SLAM system: call track() once per frame, in order")
-      .def(py::init<const py::object&, const Camera&, std::optional<uint64_t>>(), py::arg("config"),
-           py::arg("camera"), py::arg("seed") = py::none(),
+      .def(py::init<const py::object&, const Camera&, std::optional<uint64_t>,
+                    const std::optional<std::string>&>(),
+           py::arg("config"), py::arg("camera"), py::arg("seed") = py::none(),
+           py::arg("live") = py::none(),
            "config: a YAML file path (e.g. configs/7scenes.yaml), a dict of the same keys, or "
-           "None for the defaults")
+           "None for the defaults; live: \"[HOST:]PORT\" serves the run as `ademono run --live` "
+           "does (Foxglove WebSocket protocol and a page at http://HOST:PORT/, docs/live.md)")
+      .def_property_readonly(
+          "live_url", [](PySystem& s) { return s.Live().Url(); },
+          "http://HOST:PORT/ of the live view (the WebSocket is ws://HOST:PORT/)")
+      .def(
+          "wait_for_clients",
+          [](PySystem& s, size_t clients) {
+            py::gil_scoped_release release;
+            s.Live().WaitForClients(clients, nullptr);
+          },
+          py::arg("clients") = 1,
+          "Blocks until this many live clients have subscribed (as --live-wait-clients)")
+      .def(
+          "live_linger",
+          [](PySystem& s, double seconds) {
+            py::gil_scoped_release release;
+            s.Live().Linger(seconds);
+          },
+          py::arg("seconds") = 0.0,
+          "After shutdown(): serve until every live client has left, at most `seconds` once they "
+          "have the final state (as --live-linger)")
+      .def(
+          "live_stats",
+          [](PySystem& s) { return py::module_::import("json").attr("loads")(s.Live().Stats().dump()); },
+          "The live view's counts: clients, messages_sent, messages_dropped, frames_skipped, ...")
       .def("track", &PySystem::Track, py::arg("image"), py::arg("depth") = py::none(),
            py::arg("timestamp") = py::none(), py::arg("detections") = py::none(),
            "image uint8 (H, W, 3) BGR; depth float32 (H, W) metres or None; timestamp in seconds "

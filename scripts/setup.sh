@@ -49,6 +49,7 @@ apt_packages=(
   python3 python3-numpy python3-opencv python3-onnx python3-torch python3-pytest python3-open3d
   python3-dev pybind11-dev python3-matplotlib
   chromium
+  libboost-dev
   clang libclang-rt-14-dev
 )
 missing=()
@@ -101,6 +102,24 @@ if [ "$web_missing" = 1 ]; then
   cp "$web_tmp/regl/package/dist/regl.min.js" "$web_root.partial/"
   cp "$web_tmp/regl/package/LICENSE" "$web_root.partial/regl.LICENSE"
   rm -rf "$web_tmp" "$web_root" && mv "$web_root.partial" "$web_root"
+fi
+
+# The live view (src/ademono/live): npm @foxglove/schemas, whose JSON schemas CMake compiles into
+# the server, and the Node clients of its tests (@foxglove/ws-protocol, ws, ajv), pinned by
+# tests/live/package-lock.json, into .deps/foxglove; the schemas are written out as
+# .deps/foxglove/schemas/foxglove.NAME.json.
+fg_root="$here/.deps/foxglove"
+if ! cmp -s "$here/tests/live/package-lock.json" "$fg_root/package-lock.json" ||
+   [ ! -f "$fg_root/schemas/foxglove.SceneUpdate.json" ]; then
+  echo "setup: fetching the live view's npm packages (tests/live/package-lock.json)"
+  rm -rf "$fg_root.partial" && mkdir -p "$fg_root.partial/schemas"
+  cp "$here/tests/live/package.json" "$here/tests/live/package-lock.json" "$fg_root.partial/"
+  (cd "$fg_root.partial" && npm ci --silent --no-audit --no-fund >/dev/null)
+  (cd "$fg_root.partial" && node -e '
+    const s = require("./node_modules/@foxglove/schemas/dist/jsonschema/index.js");
+    for (const [name, schema] of Object.entries(s))
+      require("fs").writeFileSync("schemas/foxglove." + name + ".json", JSON.stringify(schema));')
+  rm -rf "$fg_root" && mv "$fg_root.partial" "$fg_root"
 fi
 
 if [ "$do_build" = 1 ]; then

@@ -23,7 +23,8 @@ import time
 FLAGS = [
     "--headless", "--no-sandbox", "--hide-scrollbars", "--use-angle=swiftshader",
     "--enable-unsafe-swiftshader", "--no-first-run", "--disable-extensions",
-    "--disable-background-networking", "--remote-debugging-pipe",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--disable-quic", "--remote-debugging-pipe",
 ]
 
 
@@ -36,7 +37,7 @@ def chromium():
 
 
 class Browser:
-    def __init__(self):
+    def __init__(self, extra_flags=()):
         self.profile = tempfile.TemporaryDirectory()
         to_chrome_r, self.to_chrome = os.pipe()
         self.from_chrome, from_chrome_w = os.pipe()
@@ -46,7 +47,8 @@ class Browser:
             os.dup2(from_chrome_w, 4)
 
         self.proc = subprocess.Popen(
-            [chromium()] + FLAGS + ["--user-data-dir=" + self.profile.name, "about:blank"],
+            [chromium()] + FLAGS + list(extra_flags) +
+            ["--user-data-dir=" + self.profile.name, "about:blank"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             preexec_fn=wire, pass_fds=(3, 4))  # the numbers after wire()
         os.close(to_chrome_r)
@@ -115,7 +117,13 @@ def _messages(events):
 
 def open_report(html, png, width=1280, height=4400, timeout=60):
     """Returns {"console": [lines], "ready": str, "errors": str|None, "layout": {id: [x, y, w, h]}}."""
-    browser = Browser()
+    return open_url("file://" + os.path.abspath(html), png, width, height, timeout)
+
+
+def open_url(url, png, width=1280, height=4400, timeout=60, extra_flags=(), on_poll=None):
+    """open_report for any URL (the live page: http://HOST:PORT/). on_poll(state), if given, sees
+    the page's body.dataset at every poll."""
+    browser = Browser(extra_flags)
     try:
         target = browser.call("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = browser.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
@@ -124,7 +132,7 @@ def open_report(html, png, width=1280, height=4400, timeout=60):
         browser.call("Emulation.setDeviceMetricsOverride",
                      {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False},
                      session=session)
-        browser.call("Page.navigate", {"url": "file://" + os.path.abspath(html)}, session=session)
+        browser.call("Page.navigate", {"url": url}, session=session)
         state = {}
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -132,6 +140,8 @@ def open_report(html, png, width=1280, height=4400, timeout=60):
                 "expression": "JSON.stringify(document.body ? Object.assign({}, document.body.dataset) : {})",
                 "returnByValue": True}, session=session)["result"].get("value", "{}")
             state = json.loads(state)
+            if on_poll:
+                on_poll(state)
             if state.get("ready") or state.get("errors"):
                 break
             time.sleep(0.2)

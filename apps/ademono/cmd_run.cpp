@@ -27,6 +27,7 @@
 #include "ademono/filter/visualize.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/live/live_server.h"
 #include "ademono/report/report.h"
 #include "ademono/runner/run.h"
 #include "ademono/runner/run_writer.h"
@@ -49,6 +50,11 @@ struct RunArgs : SequenceRunArgs {
   bool live_trajectory = false;
   bool realtime = false;
   double realtime_speed = 1.0;
+  std::string live;  // [HOST:]PORT of the live view
+  size_t live_wait_clients = 0;
+  double live_linger = 0;
+  double live_image_hz = 10;
+  double live_map_hz = 2;
 };
 
 // SIGINT / SIGTERM: finish the current frame, then write the outputs of the frames done so far
@@ -137,6 +143,14 @@ int Run(const RunArgs& args) {
   if (args.out.empty()) throw InputError("--out is required");
   if (args.localize_only && args.load_map.empty())
     throw InputError("--localize-only needs --load-map FILE");
+  if (args.live.empty() && (args.live_wait_clients > 0 || args.live_linger > 0))
+    throw InputError("--live-wait-clients and --live-linger need --live [HOST:]PORT");
+  std::optional<live::LiveOptions> live_options;
+  if (!args.live.empty()) {
+    live_options = live::ParseLiveAddress(args.live);
+    live_options->image_hz = args.live_image_hz;
+    live_options->map_hz = args.live_map_hz;
+  }
   CheckOutputFolder(args.out, args.overwrite);
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
@@ -191,6 +205,15 @@ int Run(const RunArgs& args) {
     fs::create_directories(args.out);
     live.emplace(fs::path(args.out) / "trajectory.live.tum");
   }
+  // The live view (docs/live.md) serves from its own thread; the run only hands it copies.
+  std::unique_ptr<live::LiveServer> live_server;
+  if (live_options) {
+    live_server = std::make_unique<live::LiveServer>(*live_options);
+    run.observer = live_server.get();
+    std::fprintf(stderr, "ademono run: live view at %s (Foxglove / Lichtblick: ws://%s)\n",
+                 live_server->Url().c_str(),
+                 live_server->Url().substr(7, live_server->Url().size() - 8).c_str());
+  }
   run.on_frame = [&](const FrameData& frame, const std::vector<Detection>& detections,
                      const TrackResult& r) {
     ++done;
@@ -220,7 +243,11 @@ int Run(const RunArgs& args) {
   run.pipeline.stop = &g_stop;
   std::optional<StopSignals> signals;
   signals.emplace();
-  const RunReport report = RunSequence(*sequence, depth.get(), detector.get(), run);
+  if (live_server && args.live_wait_clients > 0) {
+    std::fprintf(stderr, "ademono run: waiting for %zu live client(s)\n", args.live_wait_clients);
+    live_server->WaitForClients(args.live_wait_clients, &g_stop);
+  }
+  RunReport report = RunSequence(*sequence, depth.get(), detector.get(), run);
   signals.reset();  // from here a signal ends the process; the writer below is kill-safe
   const int stop_exit = report.partial ? 128 + static_cast<int>(g_stop_signal) : 0;
   if (report.partial) {
@@ -246,6 +273,8 @@ int Run(const RunArgs& args) {
   }
   if (sequence->HasGroundTruth() && !report.accuracy)
     spdlog::warn("accuracy not computed: {}", report.accuracy_note);
+  // Drops and skips up to the end of the run (the final messages are queued by now).
+  if (live_server) report.live = live_server->Stats();
   RemoveStaleStaging(args.out);
   WriteRunOutputs(report, args.out);
   WriteRunReport(args.out, ReportOptions());  // report.html, from the files just written
@@ -260,6 +289,12 @@ int Run(const RunArgs& args) {
   }
   if (report.Tracked() < report.frames) {
     std::cout << (report.frames - report.Tracked()) << " frames untracked (no pose written)\n";
+  }
+  if (live_server) {
+    // The outputs are written; the viewers get the final state, then the server closes.
+    std::cout << std::flush;
+    live_server->Linger(args.live_linger);
+    live_server->Stop();
   }
   return stop_exit;
 }
@@ -292,6 +327,26 @@ const bool kRegistered = RegisterCommand(
       app.add_flag("--live-trajectory", args->live_trajectory,
                    "also append each tracked frame's pose to OUT/trajectory.live.tum as it is "
                    "tracked (one fsynced line per frame)");
+      app.add_option("--live", args->live,
+                     "serve the run live on [HOST:]PORT (default host 127.0.0.1): the Foxglove "
+                     "WebSocket protocol for Foxglove / Lichtblick and a page at http://HOST:PORT/ "
+                     "(docs/live.md; port 0: any free port, printed)");
+      app.add_option("--live-wait-clients", args->live_wait_clients,
+                     "with --live, start only once N clients have subscribed (to every channel, "
+                     "or 1 s after their first subscription)");
+      app.add_option("--live-linger", args->live_linger,
+                     "with --live, keep serving up to SECONDS after the run, until every client "
+                     "has left (default 0: until the final messages are sent, at most 5 s)")
+          ->check(CLI::Range(0.0, 86400.0));
+      app.add_option("--live-image-hz", args->live_image_hz,
+                     "with --live, send the camera image at most this often")
+          ->check(CLI::Range(0.1, 1000.0))
+          ->capture_default_str();
+      app.add_option("--live-map-hz", args->live_map_hz,
+                     "with --live, send the map (cloud, trajectory, scene) at most this often "
+                     "while it changes (the final map always)")
+          ->check(CLI::Range(0.1, 1000.0))
+          ->capture_default_str();
       return [args] { return Run(*args); };
     });
 

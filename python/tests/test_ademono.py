@@ -254,3 +254,57 @@ def test_save_map_then_localize_only_leaves_the_file(tmp_path):
     (tmp_path / "bad.map").write_bytes(saved[:100])
     with pytest.raises(ademono.InputError, match="truncated"):
         ademono.System(config, seq.camera).load_map(tmp_path / "bad.map")
+
+
+def _websocket_first_text(url):
+    """The first text frame a Foxglove server sends (serverInfo), read over a plain socket: the
+    upgrade request with the subprotocol, then one unmasked server frame (test-only reading)."""
+    import base64
+    import socket
+    from urllib.parse import urlparse
+    u = urlparse(url)
+    with socket.create_connection((u.hostname, u.port), timeout=10) as s:
+        key = base64.b64encode(os.urandom(16)).decode()
+        s.sendall(("GET / HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                   "Sec-WebSocket-Key: %s\r\nSec-WebSocket-Version: 13\r\n"
+                   "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n"
+                   % (u.hostname, u.port, key)).encode())
+        data = b""
+        while b"\r\n\r\n" not in data:
+            data += s.recv(4096)
+        head, rest = data.split(b"\r\n\r\n", 1)
+        assert head.startswith(b"HTTP/1.1 101"), head
+        assert b"foxglove.websocket.v1" in head
+        while len(rest) < 4:
+            rest += s.recv(4096)
+        assert rest[0] == 0x81  # FIN + text
+        length, start = rest[1] & 0x7F, 2
+        if length == 126:
+            length, start = int.from_bytes(rest[2:4], "big"), 4
+        while len(rest) < start + length:
+            rest += s.recv(65536)
+        return json.loads(rest[start:start + length])
+
+
+@needs_shared
+def test_system_serves_the_live_view(tmp_path):
+    import urllib.request
+    seq = ademono.open_sequence(f"7scenes:{SEQ_A}")
+    system = ademono.System(str(REPO / "configs" / "7scenes.yaml"), seq.camera, live="127.0.0.1:0")
+    url = system.live_url
+    assert url.startswith("http://127.0.0.1:")
+    page = urllib.request.urlopen(url, timeout=10).read().decode()
+    assert "ademono live" in page and "foxglove.websocket.v1" in page
+    assert _websocket_first_text(url) == {"op": "serverInfo", "name": "ademono", "capabilities": [],
+                                          "supportedEncodings": [], "metadata": {}}
+    for i in range(20):
+        frame = seq[i]
+        system.track(frame.image, depth=frame.depth, timestamp=frame.timestamp)
+    system.shutdown()
+    system.live_linger(0)
+    stats = system.live_stats()
+    assert stats["url"] == url and stats["clients"] == 1
+    with pytest.raises(RuntimeError):
+        ademono.System(None, seq.camera).live_url
+    with pytest.raises(Exception, match=r"expected \[HOST:\]PORT"):
+        ademono.System(None, seq.camera, live="nowhere:port")

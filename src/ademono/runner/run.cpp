@@ -145,6 +145,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   const bool score = options.score_synthetic_truth && truth.Available();
   if (score) report.truth = TruthCounts{};
   std::vector<PendingPoint> pending_points;  // new map points whose fate the run's end decides
+  LiveFeed live(options.observer);
   PipelineOptions pipeline = options.pipeline;
   pipeline.on_frame = [&](const FrameData& frame, const cv::Mat&,
                           const std::vector<Detection>& detections, const TrackResult& r) {
@@ -170,6 +171,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
       truth.Score(frame, detections, r.keypoints, r.labels, &*report.truth, &r.match_state,
                   &r.created_points, &pending_points);
     if (options.on_frame) options.on_frame(frame, detections, r);
+    live.Frame(system, frame, detections, r);
   };
   std::unique_ptr<RealtimeFeed> feed;
   if (options.realtime) {
@@ -209,6 +211,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   }
   report.map_cloud = system.MapPointCloud();
   report.loops = system.Loops();
+  live.End(system, {report.frames, report.Tracked(), report.keyframes, report.map_points,
+                    report.lost, report.partial});
   // Which thread each stage ran on (the first frame is always prepared on the tracking thread).
   const std::string prep = run.prefetched ? "prefetch" : "tracking";
   const std::string mapper = options.system.mapping.threaded ? "mapping" : "tracking";
@@ -362,6 +366,7 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                      {"global_ba_ms", e.global_ba_ms}});
   }
   j["loops"] = std::move(loops);
+  if (!report.live.is_null()) j["live"] = report.live;
   return j;
 }
 

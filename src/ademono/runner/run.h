@@ -19,6 +19,7 @@
 #include "ademono/io/trajectory.h"
 #include "ademono/perception/depth_provider.h"
 #include "ademono/perception/detection.h"
+#include "ademono/runner/live_feed.h"
 #include "ademono/runner/pipeline.h"
 #include "ademono/runner/synthetic_truth.h"
 #include "ademono/slam/options.h"
@@ -98,6 +99,9 @@ struct RunOptions {
   std::optional<RealtimeOptions> realtime;
   // Called after each frame, in order, on the calling thread (progress, --viz).
   std::function<void(const FrameData&, const std::vector<Detection>&, const TrackResult&)> on_frame;
+  // A live view (src/ademono/live): gets copies of each frame and of the map as it changes, on
+  // the tracking thread, and the final map and trajectory at the end. Never changes the outputs.
+  RunObserver* observer = nullptr;
 };
 
 struct RunReport {
@@ -126,6 +130,9 @@ struct RunReport {
   Trajectory ground_truth;
   std::vector<System::ColoredPoint> map_cloud;
   std::vector<LoopEvent> loops;  // closed loops, in order
+  // What the live view did (clients, messages sent and dropped); null without one. The caller
+  // that owns the view fills it in before writing summary.json.
+  nlohmann::json live;
 
   size_t Tracked() const { return trajectory.size(); }
   double Fps() const { return wall_seconds > 0 ? static_cast<double>(frames) / wall_seconds : 0.0; }

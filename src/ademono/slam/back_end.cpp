@@ -234,7 +234,8 @@ std::vector<ColoredPoint> BackEnd::MapPointCloud() const {
     if (p->bad) continue;
     auto it = point_colors_.find(id);
     cloud.push_back(
-        {p->position, it == point_colors_.end() ? cv::Vec3b(255, 255, 255) : it->second});
+        {p->position, it == point_colors_.end() ? cv::Vec3b(255, 255, 255) : it->second,
+         p->static_probability});
   }
   return cloud;
 }

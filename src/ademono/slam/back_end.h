@@ -27,6 +27,7 @@ namespace ademono {
 struct ColoredPoint {
   Eigen::Vector3d position;
   cv::Vec3b bgr;
+  double static_probability = 1.0;  // MapPoint::static_probability (the live view's colour)
 };
 
 // The back end's part of one frame's result.
