@@ -591,4 +591,38 @@ std::string FormatReport(const EvalResult& r) {
   return out;
 }
 
+TrajectoryFile LoadTrajectoryFile(const std::string& path, const std::string& format_name) {
+  TrajectoryFile file;
+  file.path = path;
+  file.detected = format_name == "auto";
+  const TrajectoryFormat format =
+      file.detected ? DetectTrajectoryFormat(path) : ParseTrajectoryFormat(format_name);
+  file.poses = ReadPoseSeries(path, format);
+  return file;
+}
+
+EvalResult EvaluateTrajectoryFiles(const TrajectoryFile& gt, const TrajectoryFile& est,
+                                   EvalOptions options) {
+  const bool gt_indexed = gt.poses.format == TrajectoryFormat::kKittiIndexed;
+  const bool est_indexed = est.poses.format == TrajectoryFormat::kKittiIndexed;
+  options.associate_by_timestamp = !gt.poses.HasFrameIndices() && !est.poses.HasFrameIndices();
+  options.associate_by_frame_index = gt_indexed || est_indexed;
+  if (options.associate_by_frame_index &&
+      !(gt.poses.HasFrameIndices() && est.poses.HasFrameIndices())) {
+    throw InputError(
+        "an indexed KITTI file matches poses by frame index and cannot be compared "
+        "with a timestamped file: " +
+        gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
+        ToString(est.poses.format) + ")");
+  }
+  try {
+    return EvaluateTrajectories(gt.poses, est.poses, options);
+  } catch (const std::invalid_argument& e) {
+    // The evaluation does not know the files; name both here.
+    throw InputError(std::string(e.what()) + " between " + gt.path + " (" +
+                     std::to_string(gt.poses.size()) + " poses) and " + est.path + " (" +
+                     std::to_string(est.poses.size()) + " poses)");
+  }
+}
+
 }  // namespace ademono

@@ -152,6 +152,21 @@ KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
                                           std::vector<Eigen::Matrix4d> est,
                                           KittiAlignment alignment);
 
+// A trajectory file as `ademono eval` reads it: `format_name` "auto" (detected from the first data
+// line) or a TrajectoryFormat name. InputError naming the file when it cannot be read.
+struct TrajectoryFile {
+  std::string path;
+  PoseSeries poses;
+  bool detected = false;  // the format was detected, not given
+};
+TrajectoryFile LoadTrajectoryFile(const std::string& path, const std::string& format_name = "auto");
+// `ademono eval` on two files: files without timestamps (KITTI) match pose i to pose i, or by
+// the written frame index as soon as one file is indexed; the rest by timestamp (`options`'
+// association flags are set from the files). InputError naming both files when they cannot be
+// compared. `ademono batch` scores its runs through this too.
+EvalResult EvaluateTrajectoryFiles(const TrajectoryFile& gt, const TrajectoryFile& est,
+                                   EvalOptions options);
+
 nlohmann::json ToJson(const ErrorStats& stats);
 // Keys: ape, rpe_trans, rpe_rot_deg (rmse/mean/median/max/min/std), matched_poses, alignment,
 // scale (sim3), rpe_delta, rpe_unit, kitti (t_rel_percent, r_rel_deg_per_100m, ate_m, rpe_m,
