@@ -465,12 +465,18 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
   if (options.alignment == Alignment::kSe3 || options.alignment == Alignment::kSim3) {
     r.gt_from_est = UmeyamaAlignment(Positions(est_poses), Positions(gt_poses),
                                      options.alignment == Alignment::kSim3);
-  } else if (options.alignment == Alignment::kOrigin) {
+  } else if (options.alignment == Alignment::kOrigin ||
+             (options.alignment == Alignment::kNone && !options.associate_by_timestamp)) {
+    // Origin; and KITTI poses without alignment: a KITTI pose is relative to the sequence's
+    // first camera, so kitti-odom-eval expresses both trajectories relative to the first
+    // estimated frame before it measures anything. With its matrices, ATE is the same as evo's
+    // origin alignment (a rigid motion of both does not change a distance). Files that both
+    // start at the identity, as evo compares them, are unchanged.
     const Eigen::Matrix4d t = gt_poses.front() * Se3InverseByTranspose(est_poses.front());
     r.gt_from_est.rotation = t.topLeftCorner<3, 3>();
     r.gt_from_est.translation = t.topRightCorner<3, 1>();
   }
-  if (options.alignment != Alignment::kNone) {
+  if (options.alignment != Alignment::kNone || !options.associate_by_timestamp) {
     Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
     t.topLeftCorner<3, 3>() = r.gt_from_est.rotation;
     t.topRightCorner<3, 1>() = r.gt_from_est.translation;
