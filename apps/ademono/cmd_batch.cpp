@@ -39,6 +39,11 @@ int Collect(const batch::Batch& b, const std::set<std::string>& in_flight) {
     std::cout << r.status << ": " << r.id << (r.status == "missing" ? "" : ", log: " + r.log)
               << "\n";
   }
+  // A cache that failed is why its runs are missing (Slurm cancels runs whose caches failed).
+  for (const batch::Task& t : b.caches) {
+    if (!batch::IsComplete(t) && in_flight.count(t.id) == 0 && fs::exists(t.log))
+      std::cout << "failed: " << t.id << ", log: " << t.log.string() << "\n";
+  }
   std::cout << c.Count("done") << "/" << c.runs.size() << " runs done; tables in "
             << (b.dir / "results.md").string() << ", " << (b.dir / "results.csv").string() << ", "
             << (b.dir / "summary.csv").string()

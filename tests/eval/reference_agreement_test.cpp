@@ -133,10 +133,11 @@ TEST(KittiOdomEvalAgreementTest, MatchesPrintedValuesForAllAlignments) {
 }
 
 // `ademono eval`'s own APE (EvaluateTrajectoryFiles, what `eval` and `batch` print) on the KITTI
-// files agrees with kitti-odom-eval's ATE in every alignment: as published (both start at the
-// identity), in the estimate's own world frame (a SLAM system's), and as an indexed file that
-// starts later in its own frame (kitti-odom-eval's example_0 form). Without alignment this used
-// to compare the raw matrices while kitti-odom-eval measures from the first estimated frame.
+// files agrees with kitti-odom-eval's ATE in every alignment: as published (plain files that
+// start at the identity, where evo agrees too), as an indexed file in the estimate's own world
+// frame, and as an indexed file that starts later in its own frame (kitti-odom-eval's example_0
+// form). Without alignment indexed files used to be compared raw, while kitti-odom-eval measures
+// from the first estimated frame.
 TEST(KittiOdomEvalAgreementTest, EvalApeIsKittiAteInEveryAlignmentAndEstimateFrame) {
   if (!fs::exists(kTrajectories / "expected.json")) GTEST_SKIP() << "no shared data";
   const nlohmann::json expected = LoadExpected().at("kitti_odom_eval").at("example_1");
@@ -154,7 +155,10 @@ TEST(KittiOdomEvalAgreementTest, EvalApeIsKittiAteInEveryAlignmentAndEstimateFra
     published.poses = ReadPoseSeries(
         kTrajectories / "kitti-odom-eval" / "example_1" / (seq + std::string(".txt")),
         TrajectoryFormat::kKitti);
+    // In its own world frame, as an indexed file (kitti-odom-eval's format; evo reads only plain
+    // KITTI files, and compares those raw).
     TrajectoryFile moved = published;
+    moved.poses.format = TrajectoryFormat::kKittiIndexed;
     for (Eigen::Matrix4d& p : moved.poses.world_from_cam) p = own_world * p;
     // Frames 7.. as an indexed file, relative to its first pose; the ground truth indexed too.
     constexpr size_t kFirst = 7;
@@ -186,7 +190,10 @@ TEST(KittiOdomEvalAgreementTest, EvalApeIsKittiAteInEveryAlignmentAndEstimateFra
           EvaluateKittiOdometry(gt_index, gt_indexed.poses.world_from_cam, est_index,
                                 late.poses.world_from_cam, kitti)
               .ate_m;
-      EXPECT_NEAR(EvaluateTrajectoryFiles(gt_indexed, late, options).ape.rmse, kitti_late, 1e-6);
+      // To its printed 3 decimals: kitti-odom-eval moves the ground truth by the general inverse
+      // of its first pose, whose rotation is not exactly orthonormal (7 printed digits), which
+      // moves se3/sim3 by a few micrometres.
+      EXPECT_NEAR(EvaluateTrajectoryFiles(gt_indexed, late, options).ape.rmse, kitti_late, 5e-4);
       ++checked;
     }
   }

@@ -260,7 +260,10 @@ std::string ShellQuote(const std::string& word) {
 
 std::string ShellCommand(const std::vector<std::string>& argv) {
   std::string out;
-  for (const std::string& a : argv) out += (out.empty() ? "" : " ") + ShellQuote(a);
+  for (const std::string& a : argv) {
+    if (!out.empty()) out += ' ';
+    out += ShellQuote(a);
+  }
   return out;
 }
 

@@ -410,6 +410,18 @@ KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
   return result;
 }
 
+namespace {
+
+// Without alignment, poses matched by frame index (an indexed KITTI file, kitti-odom-eval's
+// format) are measured from the first estimated frame, as kitti-odom-eval measures them. Plain
+// KITTI and timestamped files keep evo's raw comparison (evo reads those formats).
+bool AnchorsAtFirstFrame(const EvalOptions& options) {
+  return options.alignment == Alignment::kNone && options.associate_by_frame_index &&
+         !options.associate_by_timestamp;
+}
+
+}  // namespace
+
 EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
                                 const EvalOptions& options) {
   options.Check();
@@ -465,18 +477,17 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
   if (options.alignment == Alignment::kSe3 || options.alignment == Alignment::kSim3) {
     r.gt_from_est = UmeyamaAlignment(Positions(est_poses), Positions(gt_poses),
                                      options.alignment == Alignment::kSim3);
-  } else if (options.alignment == Alignment::kOrigin ||
-             (options.alignment == Alignment::kNone && !options.associate_by_timestamp)) {
-    // Origin; and KITTI poses without alignment: a KITTI pose is relative to the sequence's
-    // first camera, so kitti-odom-eval expresses both trajectories relative to the first
-    // estimated frame before it measures anything. With its matrices, ATE is the same as evo's
-    // origin alignment (a rigid motion of both does not change a distance). Files that both
-    // start at the identity, as evo compares them, are unchanged.
+  } else if (options.alignment == Alignment::kOrigin || AnchorsAtFirstFrame(options)) {
+    // Origin; and indexed KITTI files without alignment: kitti-odom-eval (whose format they are)
+    // expresses both trajectories relative to the first estimated frame before it measures
+    // anything, since a KITTI pose is relative to the first camera and an estimate may start
+    // later, in its own frame. The APE is that of evo's origin alignment (a rigid motion of both
+    // changes no distance).
     const Eigen::Matrix4d t = gt_poses.front() * Se3InverseByTranspose(est_poses.front());
     r.gt_from_est.rotation = t.topLeftCorner<3, 3>();
     r.gt_from_est.translation = t.topRightCorner<3, 1>();
   }
-  if (options.alignment != Alignment::kNone || !options.associate_by_timestamp) {
+  if (options.alignment != Alignment::kNone || AnchorsAtFirstFrame(options)) {
     Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
     t.topLeftCorner<3, 3>() = r.gt_from_est.rotation;
     t.topRightCorner<3, 1>() = r.gt_from_est.translation;

@@ -71,10 +71,11 @@ struct Similarity {
 Similarity UmeyamaAlignment(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst,
                             bool with_scale);
 
-// kNone on poses matched by frame (KITTI files) measures both trajectories from the first
-// estimated frame, as kitti-odom-eval does (a KITTI pose is relative to the first camera; an
-// estimate that starts later or in its own frame is otherwise off by that offset). Timestamped
-// files (TUM, EuRoC) are compared as they are, as evo does.
+// kNone on poses matched by frame index (an indexed KITTI file, kitti-odom-eval's format)
+// measures both trajectories from the first estimated frame, as kitti-odom-eval does (a KITTI
+// pose is relative to the first camera; an estimate that starts later, in its own frame, is
+// otherwise off by that offset). Plain KITTI and timestamped files are compared as they are, as
+// evo does (kitti-odom-eval agrees on files that start at the identity, as KITTI's do).
 enum class Alignment { kNone, kSe3, kSim3, kOrigin };
 enum class DeltaUnit { kFrames, kMeters };
 enum class KittiAlignment { kNone, kScale, kSixDof, kSevenDof };
