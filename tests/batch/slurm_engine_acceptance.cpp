@@ -90,7 +90,7 @@ class SlurmBatchTest : public ::testing::Test {
     const char* seeds[] = {"3", "5"};
     for (int i = 0; i < 2; ++i) {
       const std::string name = i == 0 ? "a" : "b";
-      const Result r = Ademono(std::string("synth --scene office --motion xyz --frames 80 --seed ") +
+      const Result r = Ademono(std::string("synth --scene office --motion xyz --frames 50 --seed ") +
                                seeds[i] + " --out " + (dir_ / "data" / name).string());
       ASSERT_EQ(r.code, 0) << r.out;
     }
