@@ -28,5 +28,5 @@ function(ademono_add_test name)
     set(_env "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tools/tsan.supp")
   endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT 900 ENVIRONMENT "${_env}" ${ARG_PROPERTIES})
+    PROPERTIES ${ARG_PROPERTIES} TIMEOUT 900 ENVIRONMENT "${_env}")
 endfunction()
