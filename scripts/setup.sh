@@ -65,7 +65,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # `ademono batch --engine slurm` (its CI test and scripts/slurm_local.sh): a one-node Slurm from
-# Debian's packages. Installing them starts no daemon; slurm_local.sh does.
+# Debian's packages. slurm_local.sh starts the daemons (and uses a munged that already runs).
 slurm_missing=()
 for p in slurm-wlm munge; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || slurm_missing+=("$p")
