@@ -13,6 +13,9 @@
 #include "ademono/batch/plan.h"
 #include "ademono/batch/tasks.h"
 #include "ademono/core/error.h"
+#include "ademono/runner/ablation.h"
+#include "ademono/runner/config_file.h"
+#include "ademono/slam/options.h"
 #include "ademono/synth/generator.h"
 
 namespace fs = std::filesystem;
@@ -199,6 +202,23 @@ TEST_F(PlanTest, SlurmScriptRunsTaskIOfTheArrayWithItsLog) {
                         "/o/runs/x__full__s1 >/o/logs/x__full__s1.log 2>&1 ;;\n"));
   // A word with shell syntax stays one quoted word.
   EXPECT_THAT(script, HasSubstr("--set 'depth.max_depth=6 ; rm' --out"));
+}
+
+// Every `ablate` variant as `run --set` overrides gives the switches RunAblationVariant sets.
+TEST(AblationOverridesTest, SetTheSameSwitchesAsAblate) {
+  for (const AblationVariant& v : AllAblationVariants()) {
+    SCOPED_TRACE(v.name);
+    const SystemOptions o =
+        SystemOptions::FromYaml(LoadConfigWithOverrides("", AblationSetOverrides(v)), "(test)");
+    EXPECT_EQ(o.filter.enable_enhancement, v.enhancement);
+    EXPECT_EQ(o.filter.enable_dynamic_removal, v.dynamic_removal);
+    EXPECT_EQ(o.filter.enable_distant_filter, v.distant_filter);
+    EXPECT_EQ(o.tracking.static_test, v.geometric_test);
+    EXPECT_EQ(o.filter.dynamic.judge_small_boxes,
+              v.paper_small_boxes ? false : SystemOptions().filter.dynamic.judge_small_boxes);
+    EXPECT_EQ(FindAblationVariant(v.name), &v);
+  }
+  EXPECT_EQ(FindAblationVariant("no_such_variant"), nullptr);
 }
 
 }  // namespace
