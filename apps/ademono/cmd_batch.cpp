@@ -1,6 +1,8 @@
 // `ademono batch`: a plan of datasets x variants x seeds run as `ademono infer` / `ademono run`
 // command lines by a local process pool or as Slurm job arrays, then one table and one comparison
 // report (`--collect DIR` for a Slurm job that outlived the shell). The work is in src/ademono/batch.
+#include <atomic>
+#include <csignal>
 #include <iostream>
 #include <set>
 #include <string>
@@ -28,6 +30,33 @@ struct BatchArgs {
 };
 
 void Say(const std::string& line) { std::cerr << "ademono batch: " << line << std::endl; }
+
+// SIGINT / SIGTERM while the local engine runs: nothing more starts, the running tasks end
+// (runs write partial outputs, which the next batch redoes), then the table of what is done.
+std::atomic<int> g_stop{0};
+extern "C" void OnBatchStopSignal(int signo) { g_stop.store(signo); }
+
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction action {};
+    action.sa_handler = OnBatchStopSignal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = 0;  // no SA_RESTART: waitpid returns to look at the flag
+    sigaction(SIGINT, &action, &old_int_);
+    sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
 
 // Writes the tables and the report; lists what is not done. 0 when every run is done.
 int Collect(const batch::Batch& b, const std::set<std::string>& in_flight) {
@@ -124,9 +153,11 @@ int RunBatch(const BatchArgs& args) {
     const int jobs = args.jobs > 0 ? args.jobs : plan.jobs > 0 ? plan.jobs : batch::DefaultJobs();
     if (!tasks.empty()) {
       Say("local engine, " + std::to_string(jobs) + " at a time");
-      batch::RunLocal(tasks, jobs, Say);
+      const StopSignals signals;
+      batch::RunLocal(tasks, jobs, Say, &g_stop);
     }
-    return Collect(b, {});
+    const int collected = Collect(b, {});
+    return g_stop.load() != 0 ? 128 + g_stop.load() : collected;
   }
 
   batch::SlurmSettings settings = plan.slurm;

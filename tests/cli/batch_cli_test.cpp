@@ -4,7 +4,12 @@
 // and nothing written.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <algorithm>
 #include <filesystem>
@@ -13,6 +18,8 @@
 #include <sstream>
 
 #include "cli_test_util.h"
+
+extern char** environ;
 
 namespace fs = std::filesystem;
 
@@ -141,6 +148,63 @@ TEST_F(BatchCliTest, LocalEngineRunsThePlanOnceAndAgainOnlyWhatIsMissing) {
   const CliRun collect = Run("batch --collect " + out.string());
   ASSERT_EQ(collect.exit_code, 0) << collect.err;
   EXPECT_EQ(ReadFile(out / "results.csv"), table);
+}
+
+// SIGTERM to `batch` mid-run: nothing more starts, the running runs get SIGTERM and end
+// (incomplete), `batch` writes the table of what is done and exits 143; the next `batch` runs
+// the rest, and the runs are the same as when nothing was stopped.
+TEST_F(BatchCliTest, StoppedBySigtermAndResumed) {
+  const fs::path plan = Plan("stop.yaml",
+                             "datasets: {a: {dataset: tum:a, frames: '0:20'}}\n"
+                             "variants: {full: {depth: simulated}}\n"
+                             "seeds: [1, 2, 3, 4]\n");
+  const fs::path out = dir_ / "stop";
+  const std::string out_arg = out.string();
+  const std::string plan_arg = plan.string();
+  const std::string err_file = (dir_ / "stop.err").string();
+  std::vector<std::string> args = {ADEMONO_CLI, "--log-level", "warn", "batch", plan_arg,
+                                   "--out",     out_arg,       "--jobs", "2"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_file.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  // Once a run has started (its log exists), stop the batch.
+  for (int i = 0; i < 600 && !fs::exists(out / "logs" / "a__full__s1.log"); ++i) ::usleep(50000);
+  ::usleep(300000);
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  const std::string err = ReadFile(err_file);
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 143) << err;
+  EXPECT_THAT(err, HasSubstr("stopping: "));
+  EXPECT_TRUE(fs::exists(out / "results.csv"));
+  size_t done = 0;
+  for (const char* id : {"a__full__s1", "a__full__s2", "a__full__s3", "a__full__s4"}) {
+    done += fs::exists(out / "runs" / id / "summary.json") &&
+            ReadFile(out / "runs" / id / "summary.json").find("\"partial\": true") ==
+                std::string::npos;
+  }
+  EXPECT_LT(done, 4u) << err;
+
+  const CliRun resumed = Run("batch " + plan.string() + " --out " + out.string());
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_THAT(resumed.err, HasSubstr(std::to_string(done) + " done, 0 held by Slurm, " +
+                                     std::to_string(4 - done) + " to run"));
+  const fs::path again = dir_ / "stop_again";
+  ASSERT_EQ(Run("batch " + plan.string() + " --out " + again.string()).exit_code, 0);
+  for (const char* id : {"a__full__s1", "a__full__s2", "a__full__s3", "a__full__s4"}) {
+    EXPECT_EQ(ReadFile(out / "runs" / id / "trajectory.tum"),
+              ReadFile(again / "runs" / id / "trajectory.tum"))
+        << id;
+  }
 }
 
 TEST_F(BatchCliTest, AFailedRunIsListedWithItsLog) {

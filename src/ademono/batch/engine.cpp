@@ -1,6 +1,7 @@
 #include "ademono/batch/engine.h"
 
 #include <sys/wait.h>
+#include <csignal>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,7 +27,8 @@ int DefaultJobs() {
 }
 
 std::vector<TaskOutcome> RunLocal(const std::vector<const Task*>& tasks, int jobs,
-                                  const std::function<void(const std::string&)>& report) {
+                                  const std::function<void(const std::string&)>& report,
+                                  const std::atomic<int>* stop) {
   jobs = std::max(1, jobs);
   enum class State { kWaiting, kRunning, kOk, kFailed };
   std::vector<State> state(tasks.size(), State::kWaiting);
@@ -45,7 +47,21 @@ std::vector<TaskOutcome> RunLocal(const std::vector<const Task*>& tasks, int job
     report(os.str());
   };
 
+  bool stopping = false;
   for (;;) {
+    if (!stopping && stop != nullptr && stop->load() != 0) {
+      stopping = true;
+      report("stopping: " + std::to_string(running.size()) + " running, nothing more starts");
+      if (stop->load() == SIGTERM) {
+        for (const auto& [pid, i] : running) ::kill(pid, SIGTERM);
+      }
+      for (size_t i = 0; i < tasks.size(); ++i) {
+        if (state[i] == State::kWaiting) {
+          state[i] = State::kFailed;
+          outcomes[i].note = "not started (stopped)";
+        }
+      }
+    }
     // Start what is ready, in order; a task whose cache failed ends without running.
     for (size_t i = 0; i < tasks.size() && static_cast<int>(running.size()) < jobs; ++i) {
       if (state[i] != State::kWaiting) continue;

@@ -6,6 +6,7 @@
 //   waiting for the first (`--dependency=afterok`); each array task is an ordinary
 //   `ademono infer` / `ademono run` command line in the job script.
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <set>
@@ -27,8 +28,12 @@ struct TaskOutcome {
 
 // Runs `tasks` (caches and runs; a run waits for the caches it needs among them and is skipped
 // when one of them fails) with at most `jobs` at once. `report` gets one line per ended task.
+// Once `*stop` holds a signal number, nothing more starts; SIGTERM is passed on to the running
+// tasks (SIGINT from a terminal reached them already), which `run` answers by writing its
+// partial outputs; the call returns when they have ended.
 std::vector<TaskOutcome> RunLocal(const std::vector<const Task*>& tasks, int jobs,
-                                  const std::function<void(const std::string&)>& report);
+                                  const std::function<void(const std::string&)>& report,
+                                  const std::atomic<int>* stop = nullptr);
 // The machine's CPU count (the local pool's default size).
 int DefaultJobs();
 
