@@ -1,10 +1,10 @@
-# ademono_add_test(<name> [CLI] SOURCES ... LIBS ...)
+# ademono_add_test(<name> [CLI] SOURCES ... LIBS ... [PROPERTIES ...])
 # A GoogleTest executable whose tests CTest discovers. Tests find real data through
 # ADEMONO_SHARED_DIR (../shared beside the checkout), fixtures through ADEMONO_SOURCE_DIR and the
 # CLI through ADEMONO_CLI; only tests marked CLI (those that run it) make the CLI a build
 # dependency, so a sanitized subset (scripts/test.sh) builds just the modules it tests.
 function(ademono_add_test name)
-  cmake_parse_arguments(ARG "CLI" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "CLI" "" "SOURCES;LIBS;PROPERTIES" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main GTest::gmock)
   if(ADEMONO_TEST_OPT)
@@ -28,5 +28,5 @@ function(ademono_add_test name)
     set(_env "TSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tools/tsan.supp")
   endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT 900 ENVIRONMENT "${_env}")
+    PROPERTIES ${ARG_PROPERTIES} TIMEOUT 900 ENVIRONMENT "${_env}")
 endfunction()

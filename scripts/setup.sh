@@ -65,6 +65,19 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+# `ademono batch --engine slurm` (its CI test and scripts/slurm_local.sh): a one-node Slurm from
+# Debian's packages. slurm_local.sh starts the daemons (and uses a munged that already runs).
+slurm_missing=()
+for p in slurm-wlm munge; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || slurm_missing+=("$p")
+done
+if [ ${#slurm_missing[@]} -gt 0 ]; then
+  echo "setup: installing ${slurm_missing[*]}"
+  sudo_cmd=""; [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${slurm_missing[@]}"
+fi
+
 # ONNX Runtime 1.29 (CPU) from the npm registry into a project-local prefix.
 ort_root="$here/.deps/onnxruntime"
 if [ ! -f "$ort_root/lib/libonnxruntime.so.1" ] || [ ! -f "$ort_root/include/onnxruntime_cxx_api.h" ]; then

@@ -26,21 +26,10 @@ struct EvalArgs {
   std::string json, plot;
 };
 
-struct LoadedFile {
-  std::string path;
-  ademono::PoseSeries poses;
-  bool detected = false;
-};
+using LoadedFile = ademono::TrajectoryFile;
 
 LoadedFile Load(const std::string& path, const std::string& format_name) {
-  using namespace ademono;
-  LoadedFile file;
-  file.path = path;
-  file.detected = format_name == "auto";
-  const TrajectoryFormat format =
-      file.detected ? DetectTrajectoryFormat(path) : ParseTrajectoryFormat(format_name);
-  file.poses = ReadPoseSeries(path, format);
-  return file;
+  return ademono::LoadTrajectoryFile(path, format_name);
 }
 
 std::string Describe(const LoadedFile& file) {
@@ -50,30 +39,8 @@ std::string Describe(const LoadedFile& file) {
 }
 
 ademono::EvalResult Evaluate(const LoadedFile& gt, const LoadedFile& est,
-                             ademono::EvalOptions options) {
-  using namespace ademono;
-  // Files without timestamps (KITTI) match by frame: pose i to pose i for plain files, by the
-  // written index as kitti-odom-eval does as soon as one file is indexed.
-  const bool gt_indexed = gt.poses.format == TrajectoryFormat::kKittiIndexed;
-  const bool est_indexed = est.poses.format == TrajectoryFormat::kKittiIndexed;
-  options.associate_by_timestamp = !gt.poses.HasFrameIndices() && !est.poses.HasFrameIndices();
-  options.associate_by_frame_index = gt_indexed || est_indexed;
-  if (options.associate_by_frame_index &&
-      !(gt.poses.HasFrameIndices() && est.poses.HasFrameIndices())) {
-    throw InputError(
-        "an indexed KITTI file matches poses by frame index and cannot be compared "
-        "with a timestamped file: " +
-        gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
-        ToString(est.poses.format) + ")");
-  }
-  try {
-    return EvaluateTrajectories(gt.poses, est.poses, options);
-  } catch (const std::invalid_argument& e) {
-    // The library does not know the files; name both here.
-    throw InputError(std::string(e.what()) + " between " + gt.path + " (" +
-                     std::to_string(gt.poses.size()) + " poses) and " + est.path + " (" +
-                     std::to_string(est.poses.size()) + " poses)");
-  }
+                             const ademono::EvalOptions& options) {
+  return ademono::EvaluateTrajectoryFiles(gt, est, options);
 }
 
 // One row per estimate, evo_res style.

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "ademono/core/error.h"
+#include "ademono/depth/depth_factory.h"
 
 namespace ademono {
 namespace {
@@ -82,6 +83,31 @@ TEST_F(CacheDepthTest, RejectsEmptyFolderAndBadFiles) {
   CacheDepthProvider provider2(dir_);
   frame.name = "image_b";
   EXPECT_THROW(provider2.Depth(frame, Camera{}), InputError);
+}
+
+// A cache that says which network made it (`ademono batch` writes these) is that network's depth
+// for `run`: the same settings family and error model as model:FILE; the maps come from DIR.
+TEST_F(CacheDepthTest, CacheOfANetworkIsDescribedAsThatNetwork) {
+  const std::string spec =
+      (fs::path(ADEMONO_SOURCE_DIR) / "configs" / "models" / "fastdepth_nyu.yaml").string();
+  const DepthSourceInfo model = DescribeDepthSource("model:/models/fastdepth.onnx,spec=" + spec);
+  const DepthSourceInfo cache =
+      DescribeDepthSource("cache:" + dir_.string() + ",model=/models/fastdepth.onnx,spec=" + spec);
+  EXPECT_TRUE(cache.network);
+  EXPECT_EQ(cache.domain, "indoor");
+  EXPECT_TRUE(cache.error_model.Enabled());
+  EXPECT_EQ(cache.error_model, model.error_model);
+  EXPECT_FALSE(DescribeDepthSource("cache:" + dir_.string()).network);
+
+  cv::Mat mm(4, 6, CV_16UC1, cv::Scalar(2500));
+  ASSERT_TRUE(cv::imwrite((dir_ / "f1.png").string(), mm));
+  DepthFactoryContext context;
+  const auto provider = MakeDepthProvider(
+      "cache:" + dir_.string() + ",model=/models/fastdepth.onnx,spec=" + spec, context);
+  FrameData frame;
+  frame.name = "f1";
+  frame.image = cv::Mat(4, 6, CV_8UC3);
+  EXPECT_FLOAT_EQ(provider->Depth(frame, Camera{}).at<float>(1, 1), 2.5f);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "ademono/depth/onnx_depth.h"
 #include "ademono/depth/sensor_depth.h"
 #include "ademono/depth/simulated_depth.h"
+#include "ademono/dnn/model_arg.h"
 
 namespace ademono {
 std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
@@ -23,7 +24,8 @@ std::unique_ptr<DepthProvider> MakeDepthProvider(const std::string& spec,
   }
   if (kind == "cache") {
     if (argument.empty()) throw InputError("depth provider 'cache' needs a folder: cache:DIR");
-    return std::make_unique<CacheDepthProvider>(argument);
+    // ",model=" / ",spec=" only describe where the maps came from (DescribeDepthSource).
+    return std::make_unique<CacheDepthProvider>(ParseModelArg(argument, {"model", "spec"}).file);
   }
   // --- simulated[:k=v,...] (engineer "synth" adds this branch) ---
   if (kind == "simulated") return MakeSimulatedDepthProvider(argument, context);
@@ -41,8 +43,20 @@ DepthSourceInfo DescribeDepthSource(const std::string& spec) {
     return info;
   }
   const size_t colon = spec.find(':');
-  if (spec.substr(0, colon) != "model") return {};
-  return DescribeModelDepth(colon == std::string::npos ? "" : spec.substr(colon + 1));
+  const std::string kind = spec.substr(0, colon);
+  const std::string argument = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (kind == "cache") {
+    // A cache of a network's maps (`ademono infer`) is that network's depth: the same settings
+    // family and error model as model:FILE, so that replaying it repeats the run.
+    const ModelArg cache = ParseModelArg(argument, {"model", "spec"});
+    const auto model = cache.options.find("model");
+    if (model == cache.options.end()) return {};
+    const auto spec_file = cache.options.find("spec");
+    return DescribeModelDepth(model->second +
+                              (spec_file == cache.options.end() ? "" : ",spec=" + spec_file->second));
+  }
+  if (kind != "model") return {};
+  return DescribeModelDepth(argument);
 }
 
 }  // namespace ademono

@@ -1,8 +1,11 @@
 #pragma once
 // Builds a DepthProvider from its command-line spec:
 //   sensor                         the dataset's own depth (TUM, 7-Scenes, synthetic)
-//   cache:DIR                      precomputed maps: 16-bit PNG (mm) or 32-bit float TIFF (m),
-//                                  matched to frames by file-name stem or timestamp
+//   cache:DIR[,model=F.onnx[,spec=Y.yaml]]
+//                                  precomputed maps: 16-bit PNG (mm) or 32-bit float TIFF (m),
+//                                  matched to frames by file-name stem or timestamp; model/spec
+//                                  say which network made them (`ademono infer`), so the run
+//                                  treats them as that network's depth (DescribeDepthSource)
 //   simulated[:k=v,...]            network-like errors applied to the dataset's depth (synth)
 //   model:FILE.onnx[,spec=Y.yaml]  a metric-depth ONNX model through ONNX Runtime
 //   none                           no depth at all: the monocular core (returns null)

@@ -410,6 +410,18 @@ KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
   return result;
 }
 
+namespace {
+
+// Without alignment, poses matched by frame index (an indexed KITTI file, kitti-odom-eval's
+// format) are measured from the first estimated frame, as kitti-odom-eval measures them. Plain
+// KITTI and timestamped files keep evo's raw comparison (evo reads those formats).
+bool AnchorsAtFirstFrame(const EvalOptions& options) {
+  return options.alignment == Alignment::kNone && options.associate_by_frame_index &&
+         !options.associate_by_timestamp;
+}
+
+}  // namespace
+
 EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
                                 const EvalOptions& options) {
   options.Check();
@@ -465,12 +477,17 @@ EvalResult EvaluateTrajectories(const PoseSeries& gt, const PoseSeries& est,
   if (options.alignment == Alignment::kSe3 || options.alignment == Alignment::kSim3) {
     r.gt_from_est = UmeyamaAlignment(Positions(est_poses), Positions(gt_poses),
                                      options.alignment == Alignment::kSim3);
-  } else if (options.alignment == Alignment::kOrigin) {
+  } else if (options.alignment == Alignment::kOrigin || AnchorsAtFirstFrame(options)) {
+    // Origin; and indexed KITTI files without alignment: kitti-odom-eval (whose format they are)
+    // expresses both trajectories relative to the first estimated frame before it measures
+    // anything, since a KITTI pose is relative to the first camera and an estimate may start
+    // later, in its own frame. The APE is that of evo's origin alignment (a rigid motion of both
+    // changes no distance).
     const Eigen::Matrix4d t = gt_poses.front() * Se3InverseByTranspose(est_poses.front());
     r.gt_from_est.rotation = t.topLeftCorner<3, 3>();
     r.gt_from_est.translation = t.topRightCorner<3, 1>();
   }
-  if (options.alignment != Alignment::kNone) {
+  if (options.alignment != Alignment::kNone || AnchorsAtFirstFrame(options)) {
     Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
     t.topLeftCorner<3, 3>() = r.gt_from_est.rotation;
     t.topRightCorner<3, 1>() = r.gt_from_est.translation;
@@ -589,6 +606,40 @@ std::string FormatReport(const EvalResult& r) {
     out += buf;
   }
   return out;
+}
+
+TrajectoryFile LoadTrajectoryFile(const std::string& path, const std::string& format_name) {
+  TrajectoryFile file;
+  file.path = path;
+  file.detected = format_name == "auto";
+  const TrajectoryFormat format =
+      file.detected ? DetectTrajectoryFormat(path) : ParseTrajectoryFormat(format_name);
+  file.poses = ReadPoseSeries(path, format);
+  return file;
+}
+
+EvalResult EvaluateTrajectoryFiles(const TrajectoryFile& gt, const TrajectoryFile& est,
+                                   EvalOptions options) {
+  const bool gt_indexed = gt.poses.format == TrajectoryFormat::kKittiIndexed;
+  const bool est_indexed = est.poses.format == TrajectoryFormat::kKittiIndexed;
+  options.associate_by_timestamp = !gt.poses.HasFrameIndices() && !est.poses.HasFrameIndices();
+  options.associate_by_frame_index = gt_indexed || est_indexed;
+  if (options.associate_by_frame_index &&
+      !(gt.poses.HasFrameIndices() && est.poses.HasFrameIndices())) {
+    throw InputError(
+        "an indexed KITTI file matches poses by frame index and cannot be compared "
+        "with a timestamped file: " +
+        gt.path + " (" + ToString(gt.poses.format) + ") and " + est.path + " (" +
+        ToString(est.poses.format) + ")");
+  }
+  try {
+    return EvaluateTrajectories(gt.poses, est.poses, options);
+  } catch (const std::invalid_argument& e) {
+    // The evaluation does not know the files; name both here.
+    throw InputError(std::string(e.what()) + " between " + gt.path + " (" +
+                     std::to_string(gt.poses.size()) + " poses) and " + est.path + " (" +
+                     std::to_string(est.poses.size()) + " poses)");
+  }
 }
 
 }  // namespace ademono

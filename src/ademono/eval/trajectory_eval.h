@@ -71,6 +71,11 @@ struct Similarity {
 Similarity UmeyamaAlignment(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst,
                             bool with_scale);
 
+// kNone on poses matched by frame index (an indexed KITTI file, kitti-odom-eval's format)
+// measures both trajectories from the first estimated frame, as kitti-odom-eval does (a KITTI
+// pose is relative to the first camera; an estimate that starts later, in its own frame, is
+// otherwise off by that offset). Plain KITTI and timestamped files are compared as they are, as
+// evo does (kitti-odom-eval agrees on files that start at the identity, as KITTI's do).
 enum class Alignment { kNone, kSe3, kSim3, kOrigin };
 enum class DeltaUnit { kFrames, kMeters };
 enum class KittiAlignment { kNone, kScale, kSixDof, kSevenDof };
@@ -151,6 +156,21 @@ KittiOdometryResult EvaluateKittiOdometry(const std::vector<int64_t>& gt_index,
                                           const std::vector<int64_t>& est_index,
                                           std::vector<Eigen::Matrix4d> est,
                                           KittiAlignment alignment);
+
+// A trajectory file as `ademono eval` reads it: `format_name` "auto" (detected from the first data
+// line) or a TrajectoryFormat name. InputError naming the file when it cannot be read.
+struct TrajectoryFile {
+  std::string path;
+  PoseSeries poses;
+  bool detected = false;  // the format was detected, not given
+};
+TrajectoryFile LoadTrajectoryFile(const std::string& path, const std::string& format_name = "auto");
+// `ademono eval` on two files: files without timestamps (KITTI) match pose i to pose i, or by
+// the written frame index as soon as one file is indexed; the rest by timestamp (`options`'
+// association flags are set from the files). InputError naming both files when they cannot be
+// compared. `ademono batch` scores its runs through this too.
+EvalResult EvaluateTrajectoryFiles(const TrajectoryFile& gt, const TrajectoryFile& est,
+                                   EvalOptions options);
 
 nlohmann::json ToJson(const ErrorStats& stats);
 // Keys: ape, rpe_trans, rpe_rot_deg (rmse/mean/median/max/min/std), matched_poses, alignment,

@@ -32,6 +32,24 @@ const std::vector<AblationVariant>& AllAblationVariants() {
   return variants;
 }
 
+std::vector<std::string> AblationSetOverrides(const AblationVariant& variant) {
+  auto flag = [](bool on) { return std::string(on ? "true" : "false"); };
+  std::vector<std::string> sets = {
+      "filter.enable_enhancement=" + flag(variant.enhancement),
+      "filter.enable_dynamic_removal=" + flag(variant.dynamic_removal),
+      "filter.enable_distant_filter=" + flag(variant.distant_filter),
+      "tracking.static_test=" + flag(variant.geometric_test)};
+  if (variant.paper_small_boxes) sets.push_back("filter.judge_small_boxes=false");
+  return sets;
+}
+
+const AblationVariant* FindAblationVariant(const std::string& name) {
+  for (const AblationVariant& v : AllAblationVariants()) {
+    if (v.name == name) return &v;
+  }
+  return nullptr;
+}
+
 nlohmann::json VariantResult::ToJson() const {
   auto opt = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);

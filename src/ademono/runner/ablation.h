@@ -43,6 +43,14 @@ const std::vector<AblationVariant>& DefaultAblationVariants();
 // detector (`--detector model:...`) these compare what the boxes and the geometry each bring.
 const std::vector<AblationVariant>& AllAblationVariants();
 
+// The same variant as `ademono run` options: the config overrides ("section.key=value", for
+// --set) that RunAblationVariant applies to the system options. Without the detector
+// (use_detector false) the run also needs `--detector none`. Used by `ademono batch`, whose runs
+// are separate `run` processes.
+std::vector<std::string> AblationSetOverrides(const AblationVariant& variant);
+// The variant named `name` of AllAblationVariants(); nullptr when there is none.
+const AblationVariant* FindAblationVariant(const std::string& name);
+
 struct VariantResult {
   AblationVariant variant;
   size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
