@@ -60,6 +60,10 @@ void SimulatedDepthOptions::Check() const {
   if (!(jitter >= 0.0 && jitter <= 1.0)) throw std::invalid_argument("jitter must be in [0, 1]");
   if (!(jitter_frames >= 1.0) || !std::isfinite(jitter_frames))
     throw std::invalid_argument("jitter_frames must be >= 1");
+  if (!std::isfinite(shift) || std::abs(shift) > 10.0)
+    throw std::invalid_argument("shift must be in [-10, 10]");
+  if (!(shift_jitter >= 0.0 && shift_jitter <= 10.0))
+    throw std::invalid_argument("shift_jitter must be in [0, 10]");
 }
 
 SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
@@ -90,6 +94,10 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.jitter = ParseNumber(key, value);
     } else if (key == "jitter_frames") {
       options.jitter_frames = ParseNumber(key, value);
+    } else if (key == "shift") {
+      options.shift = ParseNumber(key, value);
+    } else if (key == "shift_jitter") {
+      options.shift_jitter = ParseNumber(key, value);
     } else if (key == "edge_blur" || key == "seed") {
       const double number = ParseNumber(key, value);
       if (number < 0 || number != std::floor(number) || number > 1.8e19)
@@ -106,8 +114,8 @@ SimulatedDepthOptions SimulatedDepthOptions::Parse(const std::string& argument,
       options.gt_dir = value;
     } else {
       BadSpec("unknown parameter '" + key +
-              "' (expected scale, a, b, pixel, edge_blur, invalid, jitter, jitter_frames, seed, "
-              "gt)");
+              "' (expected scale, a, b, pixel, edge_blur, invalid, jitter, jitter_frames, shift, "
+              "shift_jitter, seed, gt)");
     }
   }
   try {
@@ -142,19 +150,37 @@ cv::Mat SimulatedDepthProvider::Depth(const FrameData& frame, const Camera& came
   return Degrade(truth, frame.index);
 }
 
-double SimulatedDepthProvider::FrameScale(size_t frame_index) const {
-  if (options_.jitter <= 0.0) return options_.scale;
-  // Periods and phases depend on the seed only, so the signal is a function of the frame index.
-  cv::RNG rng(Mix64(options_.seed ^ 0x5CA1E) | 1);
-  constexpr int kTerms = 8;
+namespace {
+
+constexpr int kTerms = 8;
+
+// A smooth zero-mean signal of the frame index, of variance kTerms / 2: a sum of kTerms cosines
+// with periods around `frames` and phases from `seed` only.
+double CosineSum(uint64_t seed, double frames, size_t frame_index) {
+  cv::RNG rng(Mix64(seed) | 1);
   const double two_pi = 2.0 * 3.14159265358979323846;
   double sum = 0.0;
   for (int m = 0; m < kTerms; ++m) {
-    const double period = options_.jitter_frames * std::exp(rng.uniform(-0.7, 0.7));
+    const double period = frames * std::exp(rng.uniform(-0.7, 0.7));
     const double phase = rng.uniform(0.0, two_pi);
     sum += std::cos(two_pi * static_cast<double>(frame_index) / period + phase);
   }
+  return sum;
+}
+
+}  // namespace
+
+double SimulatedDepthProvider::FrameScale(size_t frame_index) const {
+  if (options_.jitter <= 0.0) return options_.scale;
+  // Periods and phases depend on the seed only, so the signal is a function of the frame index.
+  const double sum = CosineSum(options_.seed ^ 0x5CA1E, options_.jitter_frames, frame_index);
   return options_.scale * std::exp(options_.jitter * std::sqrt(2.0 / kTerms) * sum);
+}
+
+double SimulatedDepthProvider::FrameShift(size_t frame_index) const {
+  if (options_.shift_jitter <= 0.0) return options_.shift;
+  const double sum = CosineSum(options_.seed ^ 0x5A1F7, options_.jitter_frames, frame_index);
+  return options_.shift + options_.shift_jitter * std::sqrt(2.0 / kTerms) * sum;
 }
 
 cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_index) const {
@@ -211,6 +237,7 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
   }
 
   const double frame_scale = FrameScale(frame_index);
+  const double frame_shift = FrameShift(frame_index);
   const float smooth_weight = static_cast<float>(std::sqrt(1.0 - options_.pixel));
   const float pixel_weight = static_cast<float>(std::sqrt(options_.pixel));
   cv::Mat out(size, CV_32F);
@@ -228,8 +255,12 @@ cv::Mat SimulatedDepthProvider::Degrade(const cv::Mat& depth_m, size_t frame_ind
         continue;
       }
       const double sigma = options_.a * z + options_.b * z * z;
-      const double noisy =
+      double noisy =
           frame_scale * (z_edge[u] + sigma * (smooth_weight * ns[u] + pixel_weight * np[u]));
+      if (frame_shift != 0.0 && noisy > 0.0) {
+        const double inverse = 1.0 / noisy + frame_shift;
+        noisy = inverse > 0.0 ? 1.0 / inverse : 0.0;
+      }
       o[u] = noisy > 0.0 ? static_cast<float>(noisy) : 0.f;
     }
   }

@@ -13,12 +13,15 @@
 //   jitter > 0 the scale of frame k is scale * exp(jitter * J(k)), J a smooth zero-mean,
 //   unit-variance signal (a sum of 8 cosines with periods around `jitter_frames` frames and
 //   phases from the seed), the same for every pixel of the frame;
+// - shift: networks also compress or stretch the depth range, a shift in inverse depth:
+//   1 / z_out = 1 / z_scaled + shift_k (m^-1), shift_k = shift + shift_jitter * J'(k), J' a second
+//   smooth signal like J. With the scale this is a per-frame affine map in inverse depth;
 // - a fraction `invalid` of the pixels, in blobs (the top of another smooth field, ~12 px
 //   correlation), and every pixel without ground truth is 0.
 // Deterministic per frame: the noise is drawn from (seed, frame index) only.
 //
 // Spec: simulated[:scale=1.05,a=0.01,b=0.001,pixel=0.1,edge_blur=3,invalid=0.02,jitter=0,
-//                 jitter_frames=60,seed=S,gt=DIR]
+//                 jitter_frames=60,shift=0,shift_jitter=0,seed=S,gt=DIR]
 // (every key optional; seed defaults to the run's seed).
 
 #include <cstdint>
@@ -41,6 +44,8 @@ struct SimulatedDepthOptions {
   double invalid = 0.02;
   double jitter = 0.0;          // log-scale standard deviation of the per-frame scale
   double jitter_frames = 60.0;  // typical period of the scale's wandering, in frames
+  double shift = 0.0;           // m^-1: inverse-depth shift (1 / z_out = 1 / z_scaled + shift_k)
+  double shift_jitter = 0.0;    // m^-1: standard deviation of its per-frame wandering
   uint64_t seed = 0;
   std::optional<std::filesystem::path> gt_dir;  // ground truth from a depth cache folder
 
@@ -62,6 +67,10 @@ class SimulatedDepthProvider : public DepthProvider {
   cv::Mat Degrade(const cv::Mat& depth_m, size_t frame_index) const;
   // The scale bias of frame `frame_index` (scale, times the jitter when it is on).
   double FrameScale(size_t frame_index) const;
+  // The inverse-depth shift of frame `frame_index` (m^-1). With FrameScale s and shift c the
+  // frame's depths (before noise) map back to the truth as 1 / z = s / z_out - s c: an affine map
+  // in inverse depth with a = s, b = -s c.
+  double FrameShift(size_t frame_index) const;
 
  private:
   SimulatedDepthOptions options_;

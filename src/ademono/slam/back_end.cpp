@@ -44,6 +44,7 @@ void BackEnd::Shutdown() {
     MutexLock lock(map_.mutex);
     loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
     loop_closing_->FinishGlobalBundleAdjustment();
+    if (options_.loop.global_ba_at_end && !loaded_map_) loop_closing_->GlobalBundleAdjustmentNow();
   }
 }
 
@@ -216,6 +217,15 @@ std::vector<std::pair<size_t, double>> BackEnd::DepthScales() const {
     if (r.tracked) scales.emplace_back(r.index, r.depth_scale);
   }
   return scales;
+}
+
+std::vector<std::pair<size_t, InverseDepthAffine>> BackEnd::NetworkFits() const {
+  MutexLock lock(map_.mutex);
+  std::vector<std::pair<size_t, InverseDepthAffine>> fits;
+  for (const auto& [id, kf] : map_.KeyFrames()) {
+    if (kf->network_fit.valid) fits.emplace_back(kf->index, kf->network_fit);
+  }
+  return fits;
 }
 
 Trajectory BackEnd::KeyFrameTrajectory() const {

@@ -74,6 +74,9 @@ class BackEnd {
   Trajectory FrameTrajectory() const;
   Trajectory KeyFrameTrajectory() const;
   std::vector<std::pair<size_t, double>> DepthScales() const;
+  // Monocular core with a network: each live keyframe's fitted network error model (input
+  // frame index, fit), in keyframe order; keyframes without a valid fit are left out.
+  std::vector<std::pair<size_t, InverseDepthAffine>> NetworkFits() const;
   std::vector<ColoredPoint> MapPointCloud() const;
   MapFileData MapRecords() const;
   size_t NumKeyFrames() const;

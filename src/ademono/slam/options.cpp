@@ -164,7 +164,8 @@ const OptionsTable<LoopOptions>& LoopOptions::Table() {
           .Add("global_ba", &L::global_ba)
           .Add("global_ba_iterations", &L::global_ba_iterations, Range::AtLeast(1))
           .Add("global_ba_handoff_keyframes", &L::global_ba_handoff_keyframes, Range::AtLeast(1))
-          .Add("global_ba_on_save", &L::global_ba_on_save);
+          .Add("global_ba_on_save", &L::global_ba_on_save)
+          .Add("global_ba_at_end", &L::global_ba_at_end);
   return table;
 }
 

@@ -228,6 +228,9 @@ struct LoopOptions {
   // A global bundle adjustment of the whole map before `--save-map` writes it (the run's
   // trajectory follows it): the map a later session inherits (docs/maps.md).
   bool global_ba_on_save = false;
+  // The same over the whole map when the run ends, before the trajectory is read (every frame
+  // follows its keyframe): the last keyframes' structure gets the views that came after them.
+  bool global_ba_at_end = false;
   bool UseSim3(bool depth_is_prior) const {
     return transform == "sim3" || (transform == "auto" && depth_is_prior);
   }

@@ -94,6 +94,11 @@ class System {
   // Network depth: the scale correction of every tracked frame (input index, factor), against
   // the final map (anchoring rescales update it); 1 for sensor depth.
   std::vector<std::pair<size_t, double>> DepthScales() const;
+  // Monocular core with a network: the network error model fitted in each keyframe
+  // (BackEnd::NetworkFits).
+  std::vector<std::pair<size_t, InverseDepthAffine>> NetworkFits() const {
+    return back_end_.NetworkFits();
+  }
   using ColoredPoint = ademono::ColoredPoint;
   std::vector<ColoredPoint> MapPointCloud() const;
   // The live map as the records a map file holds (temporary keyframes included; tests).
