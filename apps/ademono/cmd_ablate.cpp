@@ -63,6 +63,7 @@ int Ablate(const AblateArgs& args) {
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options.system);
+  ApplyDatasetCameraHeight(config, *sequence, options.system);
   options.variants = variants;
   options.dataset = args.dataset;
   options.config = config_path.string();

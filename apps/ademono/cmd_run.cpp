@@ -147,6 +147,7 @@ int Run(const RunArgs& args) {
   const YAML::Node config = LoadConfig(config_path, args.set);
   SystemOptions options = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options);
+  ApplyDatasetCameraHeight(config, *sequence, options);
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.filter.seed = ParseSeed(args.seed);
   if (args.no_enhancement) options.filter.enable_enhancement = false;

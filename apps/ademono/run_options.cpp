@@ -135,6 +135,22 @@ void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
   options.depth.error_per_metre = depth.error_model.per_metre;
 }
 
+void ApplyDatasetCameraHeight(const YAML::Node& config, const Sequence& sequence,
+                              SystemOptions& options) {
+  const std::optional<double> height = sequence.CameraHeight();
+  if (!height) return;
+  const bool set = config && config.IsMap() && config["depth"] && config["depth"].IsMap() &&
+                   config["depth"]["camera_height"];
+  if (set) {
+    spdlog::info("depth.camera_height: {} m from the config (the {} rig's is {} m)",
+                 options.depth.camera_height, sequence.Kind(), *height);
+    return;
+  }
+  options.depth.camera_height = *height;
+  spdlog::info("depth.camera_height: {} m, the {} rig's (set depth.camera_height to change it)",
+               *height, sequence.Kind());
+}
+
 YAML::Node LoadConfig(const fs::path& path, const std::vector<std::string>& overrides) {
   YAML::Node config;
   if (!path.empty()) {

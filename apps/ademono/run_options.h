@@ -53,6 +53,11 @@ std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Seq
 // A network model's spec with an `uncertainty:` error model sets the depth error model of
 // settings that treat depth as a prior (a network settings family).
 void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options);
+// The dataset's rig height (Sequence::CameraHeight: KITTI's 1.65 m) as depth.camera_height,
+// unless `config` (the file with its --set overrides) gives that key itself: a user with
+// another vehicle sets it, 0 turns the ground scale off. Logs the choice.
+void ApplyDatasetCameraHeight(const YAML::Node& config, const Sequence& sequence,
+                              SystemOptions& options);
 // The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
 // `overrides` ("section.key=value", value in YAML) replace keys of the file; the strict option
 // readers then reject unknown ones as they would in the file.

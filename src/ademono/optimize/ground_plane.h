@@ -13,8 +13,11 @@
 // sequence is fixed by the standard, unlike the distributions).
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include <vector>
+
+#include "ademono/core/camera.h"
 
 namespace ademono {
 
@@ -33,11 +36,57 @@ struct GroundPlane {
       Eigen::Vector3d(0, -1, 0);  // unit, pointing from the plane to the camera
   double height = 0.0;            // camera's distance above the plane, in the points' units
   int num_inliers = 0;
+  int num_points = 0;             // points given (the candidates)
+  // How much to trust it (valid estimates only): the share of the candidates on the plane, the
+  // robust spread (1.4826 MAD) of the inliers' log-depth residuals, the height's standard error
+  // relative to the height from the refit's covariance at that spread (an optimistic bound:
+  // a network's errors are correlated across the frame), and one number in [0, 1] from them,
+  // inlier_share * exp(-height_sigma / 0.01): a road that fills the corridor and pins the
+  // height within 1 % gives about 0.3 or more; a car ahead or a kerb in the corridor less.
+  double inlier_share = 0.0;
+  double residual_sigma = 0.0;
+  double height_sigma = 0.0;
+  double confidence = 0.0;
 };
 
 // `points_cam`: candidate ground points in the camera frame (callers pass those below the
 // horizon and off dynamic objects). Points on other surfaces are outliers.
 GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
                                 const GroundPlaneOptions& options = {});
+
+// The road ahead of a driving camera from one frame's depth (docs/kitti.md has the measurements
+// on real KITTI frames behind each default).
+struct GroundFromDepthOptions {
+  // The corridor fitted, in the camera frame (m, the depth's units): the lane ahead. Wider takes
+  // in parked cars and kerbs; farther, the network's far depth (it reads the far road longer
+  // than the near, which tilts the plane).
+  double min_depth = 3.0;
+  double max_depth = 20.0;
+  double max_lateral = 2.0;
+  // Dense maps: one pixel every `stride` in both directions.
+  int stride = 4;
+  // Boxes (pixels) whose pixels or keypoints are no road: detected vehicles and people, parked
+  // or not.
+  GroundPlaneOptions plane;
+  void Check() const;  // throws std::invalid_argument
+};
+
+// Candidate road points of a dense depth map (CV_32FC1, 0 = invalid, at the camera's size):
+// every `stride`-th pixel below the principal point whose point lies in the corridor and
+// outside `exclude`. Distortion is undone when the camera has any.
+std::vector<Eigen::Vector3d> RoadCandidates(const cv::Mat& depth, const Camera& camera,
+                                            const std::vector<cv::Rect2d>& exclude,
+                                            const GroundFromDepthOptions& options);
+// The same selection for keypoints (pixels, distorted as observed) with depths (<= 0: none).
+std::vector<Eigen::Vector3d> RoadCandidates(const std::vector<cv::Point2f>& keypoints,
+                                            const std::vector<float>& depths,
+                                            const Camera& camera,
+                                            const std::vector<cv::Rect2d>& exclude,
+                                            const GroundFromDepthOptions& options);
+// The camera's height above the road and the road's normal (camera frame) from a frame's dense
+// depth map, with a confidence. InvalidArgument for a depth map of the wrong type or size.
+GroundPlane EstimateGroundFromDepth(const cv::Mat& depth, const Camera& camera,
+                                    const std::vector<cv::Rect2d>& exclude = {},
+                                    const GroundFromDepthOptions& options = {});
 
 }  // namespace ademono
