@@ -248,7 +248,7 @@ def main():
               f"(frames k, k+{args.gap}; parallax > {args.min_parallax} deg; every "
               f"{args.pair_every}th frame)")
         print("  depth band m   points  geometry/network p10  median  p90   "
-              "sigma log   sigma log after per-frame scale")
+              "sigma log   after per-frame scale: sigma   error (bias included)")
         report["map_bands"] = []
         bands = [(1, 5), (5, 10), (10, 20), (20, 40), (40, 80)]
         for lo, hi in bands:
@@ -261,22 +261,26 @@ def main():
             c = c[np.isfinite(c)]
             s1 = robust_sigma(log_ratio[sel])
             s2 = robust_sigma(c) if c.size >= 20 else float("nan")
+            # The error about the frame's scale, the band's own bias included (what a per-point
+            # sigma has to cover after SLAM's per-frame scale correction).
+            e2 = 1.4826 * float(np.median(np.abs(c))) if c.size >= 20 else float("nan")
             print(f"  {lo:3d}-{hi:<3d}      {sel.sum():6d}   {p[0]:.3f}   {p[1]:.3f}  {p[2]:.3f}"
-                  f"    {s1:.3f}       {s2:.3f}")
+                  f"    {s1:.3f}       {s2:.3f}                 {e2:.3f}")
             report["map_bands"].append({"band_m": [lo, hi], "points": int(sel.sum()),
                                         "ratio_p10_p50_p90": p, "sigma_log": s1,
                                         "sigma_log_after_frame_scale": s2,
+                                        "error_log_after_frame_scale": e2,
                                         "mid_depth_m": float(np.median(zt[sel]))})
         fs = percentiles(frame_scales)
         print(f"  per-frame scale (geometry/network median): p10 {fs[0]:.3f}  median {fs[1]:.3f}  "
               f"p90 {fs[2]:.3f} ({len(frame_scales)} frames)")
         report["map_frame_scale_p10_p50_p90"] = fs
-        # sigma_z / z = relative + per_metre * z, fitted to the bands' spread after the per-frame
-        # scale (least squares over the bands, weighted by their point counts).
-        b = [x for x in report["map_bands"] if np.isfinite(x["sigma_log_after_frame_scale"])]
+        # sigma_z / z = relative + per_metre * z, fitted to the bands' error after the per-frame
+        # scale, bias included (least squares over the bands, weighted by their point counts).
+        b = [x for x in report["map_bands"] if np.isfinite(x["error_log_after_frame_scale"])]
         if len(b) >= 2:
             a = np.array([[1.0, x["mid_depth_m"]] for x in b])
-            y = np.array([x["sigma_log_after_frame_scale"] for x in b])
+            y = np.array([x["error_log_after_frame_scale"] for x in b])
             w = np.sqrt(np.array([x["points"] for x in b], dtype=float))
             coef, *_ = np.linalg.lstsq(a * w[:, None], y * w, rcond=None)
             print(f"  error model fit: sigma_z / z = {coef[0]:.3f} + {coef[1]:.4f} * z")

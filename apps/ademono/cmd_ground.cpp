@@ -1,7 +1,12 @@
 // `ademono ground`: the camera's height above the road and the road's normal, frame by frame,
 // from a depth source (optimize/ground_plane.h): what a vehicle's rig reads through a depth
-// network, and how steadily. Fits the dense depth map's corridor ahead (default) or the ORB
-// keypoints with depth in it (--from keypoints, what tracking had), off the detector's boxes.
+// network, and how steadily. --from:
+//   dense      a plane fitted to the dense depth map's corridor ahead
+//   keypoints  the same to the ORB keypoints with depth in it (what tracking had)
+//   level      the height along the camera's up axis (a level rig), median over the corridor
+//   two-view   the road's homography between frame k and k + --gap under the ground-truth
+//              relative pose (no depth but the start: the level fit), in metres
+// each off the detector's boxes.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -31,6 +36,8 @@ struct GroundArgs {
   std::string detector = "none";
   std::string from = "dense";
   int every = 1;
+  int gap = 2;
+  ademono::TwoViewGroundOptions two_view;
   int orb_features = 2000;
   double reference_height = 0.0;
   ademono::GroundFromDepthOptions options;
@@ -43,8 +50,10 @@ double PitchDeg(const Eigen::Vector3d& n) { return std::atan2(n.z(), -n.y()) * 1
 double RollDeg(const Eigen::Vector3d& n) { return std::atan2(n.x(), -n.y()) * 180.0 / M_PI; }
 
 int RunGround(const GroundArgs& args) {
-  if (args.from != "dense" && args.from != "keypoints")
-    throw ademono::InputError("--from '" + args.from + "': expected dense or keypoints");
+  if (args.from != "dense" && args.from != "keypoints" && args.from != "level" &&
+      args.from != "two-view")
+    throw ademono::InputError("--from '" + args.from +
+                              "': expected dense, keypoints, level or two-view");
   if (args.every < 1) throw ademono::InputError("--every must be >= 1");
   try {
     args.options.Check();
@@ -54,6 +63,8 @@ int RunGround(const GroundArgs& args) {
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
   const auto sequence = ademono::OpenSequence(args.dataset, camera_yaml);
+  if (args.from == "two-view" && !sequence->HasGroundTruth())
+    throw ademono::InputError(args.dataset + ": --from two-view needs ground-truth poses");
   const ademono::Camera& camera = sequence->GetCamera();
   ademono::DepthFactoryContext context;
   context.sequence = sequence.get();
@@ -79,6 +90,21 @@ int RunGround(const GroundArgs& args) {
     ademono::GroundPlane plane;
     if (args.from == "dense") {
       plane = ademono::EstimateGroundFromDepth(map, camera, boxes, args.options);
+    } else if (args.from == "level" || args.from == "two-view") {
+      plane = ademono::GroundHeightAlong(ademono::RoadCandidates(map, camera, boxes, args.options),
+                                         Eigen::Vector3d(0, -1, 0), args.options.plane);
+      const size_t j = i + static_cast<size_t>(args.gap);
+      if (args.from == "two-view") {
+        if (j >= sequence->Size()) break;
+        const ademono::FrameData other = sequence->Load(j);
+        const ademono::Rigid3d b_from_a =
+            other.world_from_cam_gt->inverse() * *frame.world_from_cam_gt;
+        // The level fit only starts it (its height within about 20 %).
+        plane = plane.height > 0 ? ademono::EstimateGroundFromTwoViews(
+                                       frame.image, other.image, b_from_a, camera, plane, boxes,
+                                       args.two_view)
+                                 : ademono::GroundPlane();
+      }
     } else {
       std::vector<cv::KeyPoint> keypoints;
       cv::Mat descriptors;
@@ -162,6 +188,12 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--from", args->from, "dense (the depth map) | keypoints (ORB with depth)")
           ->capture_default_str();
       app.add_option("--every", args->every, "every Nth frame")->capture_default_str();
+      app.add_option("--gap", args->gap, "two-view: the second view is this many frames later")
+          ->capture_default_str();
+      app.add_flag("!--fixed-normal", args->two_view.fit_normal,
+                   "two-view: keep the level normal, fit the height only");
+      app.add_option("--finest-level", args->two_view.finest_level, "two-view: pyramid level")
+          ->capture_default_str();
       app.add_option("--orb-features", args->orb_features, "--from keypoints: ORB features")
           ->capture_default_str();
       app.add_option("--min-depth", args->options.min_depth, "corridor: nearest (m)")

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ademono/core/camera.h"
+#include "ademono/core/geometry.h"
 
 namespace ademono {
 
@@ -83,10 +84,49 @@ std::vector<Eigen::Vector3d> RoadCandidates(const std::vector<cv::Point2f>& keyp
                                             const Camera& camera,
                                             const std::vector<cv::Rect2d>& exclude,
                                             const GroundFromDepthOptions& options);
+// The height above a plane of known normal (unit after normalising; pointing from the plane to
+// the camera, e.g. the camera's up axis (0, -1, 0) for a level rig, or the map's road normal):
+// the median of -normal.p, with the share of points within inlier_ratio (in log) of it.
+GroundPlane GroundHeightAlong(const std::vector<Eigen::Vector3d>& points_cam,
+                              const Eigen::Vector3d& normal, const GroundPlaneOptions& options = {});
 // The camera's height above the road and the road's normal (camera frame) from a frame's dense
 // depth map, with a confidence. InvalidArgument for a depth map of the wrong type or size.
 GroundPlane EstimateGroundFromDepth(const cv::Mat& depth, const Camera& camera,
                                     const std::vector<cv::Rect2d>& exclude = {},
                                     const GroundFromDepthOptions& options = {});
+
+// The road from two views of it and their relative pose, without depth: the road's pixels in
+// view a, mapped into view b by the homography the plane induces, K (R + t m^T) K^-1 with
+// m = normal / height, must look the same. Gauss-Newton on m (and a gain and bias for
+// exposure) over the corridor's pixels, coarse to fine, Huber-weighted. The height comes out in
+// the units of b_from_a's translation (metres for ground-truth poses, the map's units for SLAM's):
+// geometry measures the road where a network reads it with its own distortions (docs/kitti.md).
+struct TwoViewGroundOptions {
+  // The corridor in view a, placed with the initial plane: its depth range and half width
+  // (initial plane units), off the excluded boxes.
+  double min_depth = 5.0;
+  double max_depth = 15.0;
+  double max_lateral = 2.0;
+  int coarsest_level = 2;    // pyramid levels (halvings) from coarse to finest_level
+  int finest_level = 1;
+  int iterations = 20;       // Gauss-Newton steps per level
+  double huber = 8.0;        // intensity units (0..255)
+  int min_pixels = 2000;     // corridor pixels at the finest level; fewer: no estimate
+  double min_inlier_share = 0.5;  // residuals within `huber`
+  double max_tilt_deg = 5.0;      // of the result's normal from the initial plane's
+  // false: the initial normal is kept and only the height is fitted (a normal known from
+  // elsewhere, e.g. the map's road over many keyframes).
+  bool fit_normal = true;
+  void Check() const;             // throws std::invalid_argument
+};
+// `image_a`, `image_b`: the two frames (CV_8UC1 or CV_8UC3, the camera's size); `b_from_a` view
+// b's pose relative to a (at least a few centimetres of translation); `initial`: a plane to
+// start from (normal and height in b_from_a's units, e.g. a depth fit's scaled into them, or
+// the level road at the rig's height). InvalidArgument for images of the wrong size.
+GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& image_b,
+                                       const Rigid3d& b_from_a, const Camera& camera,
+                                       const GroundPlane& initial,
+                                       const std::vector<cv::Rect2d>& exclude = {},
+                                       const TwoViewGroundOptions& options = {});
 
 }  // namespace ademono
