@@ -267,6 +267,7 @@ void TwoViewGroundOptions::Check() const {
   if (iterations < 1) throw std::invalid_argument("two-view ground: iterations must be >= 1");
   if (!(huber > 0)) throw std::invalid_argument("two-view ground: huber must be > 0");
   if (min_pixels < 10) throw std::invalid_argument("two-view ground: min_pixels must be >= 10");
+  if (!(min_gradient >= 0)) throw std::invalid_argument("two-view ground: min_gradient must be >= 0");
   if (!(min_inlier_share >= 0 && min_inlier_share <= 1))
     throw std::invalid_argument("two-view ground: min_inlier_share must be in [0, 1]");
   if (!(max_tilt_deg > 0 && max_tilt_deg < 90))
@@ -335,6 +336,7 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
   std::vector<double> residuals;
   Eigen::Matrix<double, 5, 5> normal_matrix = Eigen::Matrix<double, 5, 5>::Zero();
   int used = 0, inliers = 0;
+  double gradient_energy = 0;  // sum of |grad b|^2 over the pixels used (texture)
   for (int level = options.coarsest_level; level >= options.finest_level; --level) {
     const double s = 1.0 / (1 << level);
     const cv::Mat& ia = pa[level];
@@ -342,9 +344,9 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
     cv::Mat gx, gy;
     cv::Sobel(ib, gx, CV_32F, 1, 0, 3, 1.0 / 8);
     cv::Sobel(ib, gy, CV_32F, 0, 1, 3, 1.0 / 8);
-    // Pixel (c, r) at this level is (c + 0.5) / s - 0.5 at full resolution.
+    // pyrDown's pixel c is centred on pixel 2c of the level below: c / s at full resolution.
     const double fx = camera.fx * s, fy = camera.fy * s;
-    const double cx = (camera.cx + 0.5) * s - 0.5, cy = (camera.cy + 0.5) * s - 0.5;
+    const double cx = camera.cx * s, cy = camera.cy * s;
     // The corridor, placed with the plane as it stands at the start of this level.
     struct Pixel {
       Eigen::Vector3d ray;  // normalised ray of view a, (x, y, 1)
@@ -353,7 +355,7 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
     std::vector<Pixel> pixels;
     for (int r = 0; r < ia.rows; ++r) {
       for (int c = 0; c < ia.cols; ++c) {
-        const double u0 = (c + 0.5) / s - 0.5, v0 = (r + 0.5) / s - 0.5;
+        const double u0 = c / s, v0 = r / s;
         if (InAnyBox(u0, v0, exclude)) continue;
         Eigen::Vector2d px(u0, v0);
         if (distorted) px = camera.Undistort(px);
@@ -373,6 +375,7 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
       Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
       residuals.clear();
       used = inliers = 0;
+      gradient_energy = 0;
       for (const Pixel& p : pixels) {
         const double d = m.dot(p.ray);
         const Eigen::Vector3d w = rotation * p.ray + t * d;
@@ -395,6 +398,7 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
         h += weight * j.transpose() * j;
         g += weight * j.transpose() * r;
         residuals.push_back(r);
+        gradient_energy += static_cast<double>(dx) * dx + static_cast<double>(dy) * dy;
         ++used;
         inliers += std::abs(r) <= options.huber ? 1 : 0;
       }
@@ -445,7 +449,10 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
   result.height_sigma = result.residual_sigma *
                         std::sqrt(std::max(0.0, dlog_height.dot(covariance * dlog_height)));
   result.confidence = result.inlier_share * std::exp(-result.height_sigma / 0.01);
-  result.valid = used >= options.min_pixels && result.inlier_share >= options.min_inlier_share;
+  // A road without texture (or a uniform image) does not constrain the plane.
+  const double rms_gradient = used > 0 ? std::sqrt(gradient_energy / used) : 0.0;
+  result.valid = used >= options.min_pixels && result.inlier_share >= options.min_inlier_share &&
+                 rms_gradient >= options.min_gradient && std::isfinite(result.height_sigma);
   return result;
 }
 

@@ -113,6 +113,7 @@ struct TwoViewGroundOptions {
   double huber = 8.0;        // intensity units (0..255)
   int min_pixels = 2000;     // corridor pixels at the finest level; fewer: no estimate
   double min_inlier_share = 0.5;  // residuals within `huber`
+  double min_gradient = 1.0;      // RMS image gradient over the corridor (intensity / px)
   double max_tilt_deg = 5.0;      // of the result's normal from the initial plane's
   // false: the initial normal is kept and only the height is fitted (a normal known from
   // elsewhere, e.g. the map's road over many keyframes).
