@@ -9,6 +9,7 @@
 // each off the detector's boxes.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +25,7 @@
 #include "ademono/io/sequence.h"
 #include "ademono/optimize/ground_plane.h"
 #include "command.h"
+#include "run_options.h"
 
 namespace fs = std::filesystem;
 
@@ -36,6 +38,7 @@ struct GroundArgs {
   std::string detector = "none";
   std::string from = "dense";
   int every = 1;
+  std::string frames;
   int gap = 2;
   ademono::TwoViewGroundOptions two_view;
   int orb_features = 2000;
@@ -80,12 +83,16 @@ int RunGround(const GroundArgs& args) {
   size_t total = 0;
   std::cout << "frame  valid  height_m  pitch_deg  roll_deg  points  inliers  share  sigma  "
                "height_sigma  confidence\n";
-  for (size_t i = 0; i < sequence->Size(); i += static_cast<size_t>(args.every)) {
+  size_t start = 0, end = sequence->Size();
+  if (!args.frames.empty()) ademono::cli::ParseFrames(args.frames, sequence->Size(), &start, &end);
+  end = std::min(end, sequence->Size());
+  for (size_t i = start; i < end; i += static_cast<size_t>(args.every)) {
     const ademono::FrameData frame = sequence->Load(i);
     const cv::Mat map = depth->Depth(frame, camera);
     std::vector<cv::Rect2d> boxes;
     if (detector) {
-      for (const ademono::Detection& d : detector->Detect(frame)) boxes.emplace_back(d.box.x, d.box.y, d.box.width, d.box.height);
+      for (const ademono::Detection& d : detector->Detect(frame))
+        boxes.emplace_back(d.box.x, d.box.y, d.box.width, d.box.height);
     }
     ademono::GroundPlane plane;
     if (args.from == "dense") {
@@ -187,6 +194,7 @@ const bool kRegistered = ademono::cli::RegisterCommand(
           ->capture_default_str();
       app.add_option("--from", args->from, "dense (the depth map) | keypoints (ORB with depth)")
           ->capture_default_str();
+      app.add_option("--frames", args->frames, "START:END frame range (END exclusive)");
       app.add_option("--every", args->every, "every Nth frame")->capture_default_str();
       app.add_option("--gap", args->gap, "two-view: the second view is this many frames later")
           ->capture_default_str();
