@@ -54,7 +54,13 @@ start=$(date +%s.%N)
   { echo "bench_kitti: infer failed, see $out/infer.log" >&2; exit 1; }
 end=$(date +%s.%N)
 echo "$before $(load) $start $end" > "$out/infer.load"
-run_case cache --depth "cache:$out/cache/depth" --detector "cache:$out/cache/detections.jsonl"
+# A cache is no `model:` to `run`: give it the settings the model runs got (network_outdoor.yaml
+# and the spec's error model), so the three runs differ only in where depth comes from.
+rel=$(sed -n 's/^  relative: //p' "$here/configs/models/pydnet_kitti.yaml")
+per=$(sed -n 's/^  per_metre: //p' "$here/configs/models/pydnet_kitti.yaml")
+run_case cache --config "$here/configs/network_outdoor.yaml" --set "depth.error_relative=$rel" \
+    --set "depth.error_per_metre=$per" \
+    --depth "cache:$out/cache/depth" --detector "cache:$out/cache/detections.jsonl"
 if cmp -s "$out/prefetch1/trajectory.tum" "$out/prefetch2/trajectory.tum"; then
   echo "prefetch1 and prefetch2 trajectories: byte-identical"
 else

@@ -202,6 +202,13 @@ const bool kRegistered = ademono::cli::RegisterCommand(
                    "two-view: keep the level normal, fit the height only");
       app.add_option("--finest-level", args->two_view.finest_level, "two-view: pyramid level")
           ->capture_default_str();
+      app.add_option("--view-min-depth", args->two_view.min_depth, "two-view corridor: nearest")
+          ->capture_default_str();
+      app.add_option("--view-max-depth", args->two_view.max_depth, "two-view corridor: farthest")
+          ->capture_default_str();
+      app.add_option("--view-max-lateral", args->two_view.max_lateral,
+                     "two-view corridor: to either side")
+          ->capture_default_str();
       app.add_option("--orb-features", args->orb_features, "--from keypoints: ORB features")
           ->capture_default_str();
       app.add_option("--min-depth", args->options.min_depth, "corridor: nearest (m)")
