@@ -63,6 +63,7 @@ int Ablate(const AblateArgs& args) {
   AblationOptions options;
   options.system = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options.system);
+  ApplyDatasetCameraHeight(config, *sequence, options.system);
   options.variants = variants;
   options.dataset = args.dataset;
   options.config = config_path.string();
@@ -72,6 +73,7 @@ int Ablate(const AblateArgs& args) {
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &options.pipeline.start, &options.pipeline.end);
   options.pipeline.overlap = !args.no_overlap;
+  options.pipeline.prefetch_frames = PrefetchFrames(args);
 
   DepthFactoryContext context;
   context.sequence = sequence.get();

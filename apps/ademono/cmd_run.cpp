@@ -161,6 +161,7 @@ int Run(const RunArgs& args) {
   const YAML::Node config = LoadConfig(config_path, args.set);
   SystemOptions options = SystemOptions::FromYaml(config, config_path);
   ApplyDepthSource(args.depth, options);
+  ApplyDatasetCameraHeight(config, *sequence, options);
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   if (!args.seed.empty()) options.filter.seed = ParseSeed(args.seed);
   if (args.no_enhancement) options.filter.enable_enhancement = false;
@@ -175,6 +176,7 @@ int Run(const RunArgs& args) {
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &run.pipeline.start, &run.pipeline.end);
   run.pipeline.overlap = !args.no_overlap;
+  run.pipeline.prefetch_frames = PrefetchFrames(args);
   run.load_map = args.load_map;
   run.localize_only = args.localize_only;
   run.save_map = args.save_map;

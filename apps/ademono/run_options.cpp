@@ -30,12 +30,20 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
       "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
   app.add_flag("--no-overlap", args.no_overlap,
                "compute depth/detections sequentially (no prefetch)");
+  app.add_option("--prefetch-frames", args.prefetch_frames,
+                 "frames prepared ahead at once (default: 2 with --depth model:, else 1)")
+      ->check(CLI::Range(0, 8));
   app.add_option("--viz", args.viz, "write per-frame images with filter labels into DIR");
   app.add_option("--camera", args.camera, "camera YAML (overrides the dataset's)");
   app.add_option("--set", args.set,
                  "override a config key: SECTION.KEY=VALUE (repeatable), e.g. "
                  "--set depth.scale_correction=false");
   app.add_option("--out", args.out, "output directory")->required();
+}
+
+int PrefetchFrames(const SequenceRunArgs& args) {
+  if (args.prefetch_frames > 0) return args.prefetch_frames;
+  return args.depth.rfind("model:", 0) == 0 ? 2 : 1;
 }
 
 fs::path FindConfigDir() {
@@ -147,6 +155,22 @@ void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
   if (!depth.network || !depth.error_model.Enabled() || !options.depth.IsPrior()) return;
   options.depth.error_relative = depth.error_model.relative;
   options.depth.error_per_metre = depth.error_model.per_metre;
+}
+
+void ApplyDatasetCameraHeight(const YAML::Node& config, const Sequence& sequence,
+                              SystemOptions& options) {
+  const std::optional<double> height = sequence.CameraHeight();
+  if (!height) return;
+  const bool set = config && config.IsMap() && config["depth"] && config["depth"].IsMap() &&
+                   config["depth"]["camera_height"];
+  if (set) {
+    spdlog::info("depth.camera_height: {} m from the config (the {} rig's is {} m)",
+                 options.depth.camera_height, sequence.Kind(), *height);
+    return;
+  }
+  options.depth.camera_height = *height;
+  spdlog::info("depth.camera_height: {} m, the {} rig's (set depth.camera_height to change it)",
+               *height, sequence.Kind());
 }
 
 YAML::Node LoadConfig(const fs::path& path, const std::vector<std::string>& overrides) {

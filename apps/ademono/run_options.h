@@ -26,13 +26,18 @@ struct SequenceRunArgs {
   std::string frames;
   std::string seed;  // empty: the config's filter.seed
   bool no_overlap = false;
+  int prefetch_frames = 0;  // 0: 2 with a depth network (model:), else 1
   std::string viz;
   std::string camera;
   std::string out;
   std::vector<std::string> set;  // --set section.key=value overrides of the config
 };
-// --dataset --config --depth --detector --frames --seed --no-overlap --viz --camera --out.
+// --dataset --config --depth --detector --frames --seed --no-overlap --prefetch-frames --viz
+// --camera --out.
 void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args);
+// --prefetch-frames, or its default for the depth source: a network slower than tracking
+// (model:) gets two frames prepared at once, on both cores (runner/pipeline.h).
+int PrefetchFrames(const SequenceRunArgs& args);
 
 // Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
 // binary was built from (bin/ is build/<name>/bin). Empty when none is found.
@@ -53,6 +58,11 @@ std::filesystem::path ResolveConfigPath(const std::string& config_arg, const Seq
 // A network model's spec with an `uncertainty:` error model sets the depth error model of
 // settings that treat depth as a prior (a network settings family).
 void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options);
+// The dataset's rig height (Sequence::CameraHeight: KITTI's 1.65 m) as depth.camera_height,
+// unless `config` (the file with its --set overrides) gives that key itself: a user with
+// another vehicle sets it, 0 turns the ground scale off. Logs the choice.
+void ApplyDatasetCameraHeight(const YAML::Node& config, const Sequence& sequence,
+                              SystemOptions& options);
 // The YAML of `path` (an empty node for an empty path); InputError naming the file when invalid.
 // `overrides` ("section.key=value", value in YAML) replace keys of the file; the strict option
 // readers then reject unknown ones as they would in the file.

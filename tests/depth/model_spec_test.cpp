@@ -92,6 +92,29 @@ TEST(ModelSpecTest, DisparityAndCanonicalFocal) {
   EXPECT_DOUBLE_EQ(canonical.ToDepth(4.0, 0.5), 2.0);
 }
 
+TEST(ModelSpecTest, DisparityAsAFractionOfTheWidth) {
+  // PyDNet on KITTI: depth = 0.54 m * fx / (d * W). By hand, fx = 718.856, W = 1241, d = 0.1:
+  // 0.54 * 718.856 = 388.18224; 0.1 * 1241 = 124.1; 388.18224 / 124.1 = 3.12798...
+  const DepthModelSpec spec = Parse("output:\n  kind: disparity_width\n  baseline: 0.54\n");
+  EXPECT_EQ(spec.kind, DepthModelSpec::Kind::kDisparityWidth);
+  EXPECT_NEAR(spec.ToDepth(0.1, 1.0, 718.856 / 1241.0), 3.1279793714746172, 1e-12);
+  // d = 0.02 (a far point): five times as far.
+  EXPECT_NEAR(spec.ToDepth(0.02, 1.0, 718.856 / 1241.0), 15.639896857373086, 1e-12);
+  // The same camera at half resolution (fx and W both halved) reads the same depth.
+  EXPECT_DOUBLE_EQ(spec.ToDepth(0.1, 1.0, 359.428 / 620.5), spec.ToDepth(0.1, 1.0, 718.856 / 1241.0));
+  EXPECT_EQ(spec.ToDepth(0.0, 1.0, 0.5), 0.0);
+  EXPECT_EQ(spec.ToDepth(-0.1, 1.0, 0.5), 0.0);
+  EXPECT_EQ(spec.ToDepth(0.1, 1.0, 0.0), 0.0);  // no camera: no depth
+  EXPECT_EQ(ToString(spec.kind), "disparity_width");
+  EXPECT_THAT(ParseError("output:\n  kind: disparity_width\n"), testing::HasSubstr("baseline"));
+  EXPECT_THAT(ParseError("output:\n  kind: disparity_width\n  baseline: -0.5\n"),
+              testing::HasSubstr("output.baseline"));
+  // Round trip through ToYaml.
+  EXPECT_TRUE(DepthModelSpec::FromYaml(spec.ToYaml(), "back.yaml") == spec);
+  EXPECT_EQ(spec.ToYaml()["output"]["kind"].as<std::string>(), "disparity_width");
+  EXPECT_EQ(spec.ToYaml()["output"]["baseline"].as<double>(), 0.54);
+}
+
 TEST(ModelSpecTest, LetterboxGeometry) {
   const DepthModelSpec spec = Parse("input:\n  resize: letterbox\n  width: 1064\n  height: 616\n");
   cv::Size input, content;
@@ -104,7 +127,7 @@ TEST(ModelSpecTest, ErrorsNameTheFileAndKey) {
   EXPECT_EQ(ParseError("input:\n  colour: rgb\n"), "spec.yaml: unknown key 'input.colour'");
   EXPECT_EQ(ParseError("output:\n  kind: depthish\n"),
             "spec.yaml: output.kind: cannot parse 'depthish', expected one of metric, inverse, "
-            "disparity");
+            "disparity, disparity_width");
   EXPECT_EQ(ParseError("input:\n  width: wide\n"), "spec.yaml: input.width: cannot parse 'wide'");
   EXPECT_EQ(ParseError("input:\n  mean: [1, 2]\n"),
             "spec.yaml: input.mean: cannot parse '[1, 2]', expected a number or a list of 3 "

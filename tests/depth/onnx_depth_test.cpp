@@ -174,6 +174,24 @@ TEST(OnnxDepthTest, DynamicSizeRoundedToMultipleWithoutPadding) {
   ExpectAll(provider.DepthFromImage(Grey(64, 48, 51), MakeCamera(64, 48)), 2.0f);
 }
 
+TEST(OnnxDepthTest, DisparityAsAFractionOfTheImageWidth) {
+  // y = grey / 25.5 = 2 for grey 51 (the half-resolution disparity model, resampled back).
+  // depth = baseline * fx / (y * W): 0.54 * 500 / (2 * 128) = 1.0546875 m by hand, at whatever
+  // size the network sees the image.
+  const auto spec = WriteSpec(
+      "disparity_width", FixedSpec("", "  kind: disparity_width\n  baseline: 0.54\n"));
+  auto provider = Load("depth_disparity.onnx", spec);
+  ExpectAll(provider.DepthFromImage(Grey(128, 96, 51), MakeCamera(128, 96, 500.0)), 1.0546875f);
+  // A wider lens on the same sensor (fx 250): half the depth for the same disparity fraction.
+  ExpectAll(provider.DepthFromImage(Grey(128, 96, 51), MakeCamera(128, 96, 250.0)), 0.52734375f);
+  // A camera given at twice the image's resolution: fx / W unchanged, so the depth too.
+  ExpectAll(provider.DepthFromImage(Grey(128, 96, 51), MakeCamera(256, 192, 1000.0)), 1.0546875f);
+  // Grey 102: y = 4, half the depth.
+  ExpectAll(provider.DepthFromImage(Grey(128, 96, 102), MakeCamera(128, 96, 500.0)), 0.52734375f);
+  Camera unknown;  // no intrinsics: no way to convert
+  EXPECT_THROW(provider.DepthFromImage(Grey(128, 96, 51), unknown), std::invalid_argument);
+}
+
 TEST(OnnxDepthTest, CanonicalFocalScalesByFocalAtNetworkResolution) {
   // 128x96 -> 64x48 halves fx = 500 to 250: depth = y * 250 / 1000 = 2 * 0.25.
   const auto spec =

@@ -279,6 +279,10 @@ TEST(KittiTest, ReadsGreyImagesCalibTimesAndPoses) {
   EXPECT_EQ(f.image.type(), CV_8UC3);  // grey converted to BGR
   EXPECT_EQ(f.image.at<cv::Vec3b>(5, 5), cv::Vec3b(80, 80, 80));
   EXPECT_NEAR(f.world_from_cam_gt->translation().z(), 1.6, 1e-12);
+  EXPECT_EQ(seq->CameraHeight(), 1.65);  // the KITTI rig's
+  // Another rig's camera: no KITTI camera height.
+  WriteText(root / "cam.yaml", "width: 32\nheight: 24\nfx: 30\nfy: 30\ncx: 16\ncy: 12\n");
+  EXPECT_FALSE(OpenSequence("kitti:" + dir.string(), root / "cam.yaml")->CameraHeight());
 
   WriteText(dir / "times.txt", "0.0\n0.1\n");
   EXPECT_THAT(ExpectInputError([&] { OpenSequence("kitti:" + dir.string()); }),
@@ -287,6 +291,51 @@ TEST(KittiTest, ReadsGreyImagesCalibTimesAndPoses) {
   WriteText(dir / "calib.txt", "P0: 700 0 16 0 0 701 12\n");
   EXPECT_THAT(ExpectInputError([&] { OpenSequence("kitti:" + dir.string()); }),
               HasSubstr("calib.txt:1: P0 needs 12 numbers, found 7"));
+}
+
+TEST(KittiTest, ColourCameraGroundTruthIsCameraZerosMovedByTheCalibrationOffset) {
+  const fs::path root = MakeTempDir();
+  const fs::path dir = root / "00";
+  fs::create_directories(dir / "image_2");
+  for (int i = 0; i < 2; ++i) {
+    cv::imwrite((dir / "image_2" / ("00000" + std::to_string(i) + ".jpg")).string(),
+                cv::Mat(kH, kW, CV_8UC3, cv::Scalar(10, 20, 30)));
+  }
+  // P2 = K [I | t]: tz = 0.002, ty = (-0.7 - 12 * 0.002) / 701, tx = (42 - 16 * 0.002) / 700.
+  WriteText(dir / "calib.txt",
+            "P0: 700 0 16 0 0 701 12 0 0 0 1 0\nP2: 700 0 16 42 0 701 12 -0.7 0 0 1 0.002\n");
+  // Camera 0 turned 90 degrees about y (yaw) at (1, 0, 2) in frame 1.
+  WriteText(root / "poses" / "00.txt",
+            "1 0 0 0 0 1 0 0 0 0 1 0\n0 0 1 1 0 1 0 0 -1 0 0 2\n");
+  const auto seq = OpenSequence("kitti:" + dir.string());
+  ASSERT_EQ(seq->Size(), 2u);
+  const Eigen::Vector3d t(41.968 / 700, -0.724 / 701, 0.002);
+  const Rigid3d first = *seq->Load(0).world_from_cam_gt;
+  EXPECT_LT((first.translation() + t).norm(), 1e-12);
+  EXPECT_TRUE(first.linear().isIdentity(1e-12));
+  // The offset turns with the camera: world = R (-t) + (1, 0, 2), R x = (z, y, -x).
+  const Rigid3d second = *seq->Load(1).world_from_cam_gt;
+  EXPECT_LT((second.translation() - Eigen::Vector3d(1 - t.z(), -t.y(), 2 + t.x())).norm(), 1e-12);
+}
+
+TEST(KittiTest, ReadsTheSharedDriveWithTheRigsCameraHeight) {
+  const auto seq =
+      OpenSequence(std::string("kitti:") + ADEMONO_SHARED_DIR + "/data/kitti-00/sequences/00");
+  ASSERT_EQ(seq->Size(), 200u);
+  EXPECT_EQ(seq->GetCamera().width, 1241);
+  EXPECT_EQ(seq->GetCamera().height, 376);
+  EXPECT_EQ(seq->GetCamera().fx, 718.856);
+  EXPECT_EQ(seq->GetCamera().cy, 185.2157);
+  EXPECT_EQ(seq->CameraHeight(), 1.65);
+  EXPECT_TRUE(seq->HasGroundTruth());
+  EXPECT_DOUBLE_EQ(seq->Timestamp(199), 19.9);
+  const FrameData f = seq->Load(199);
+  EXPECT_EQ(f.name, "000199");
+  EXPECT_EQ(f.image.size(), cv::Size(1241, 376));
+  // Frame 0's camera 0 is the origin; the colour camera sits 6 cm to its left.
+  const Rigid3d first = *seq->Load(0).world_from_cam_gt;
+  EXPECT_NEAR(first.translation().x(), -0.0599, 1e-4);
+  EXPECT_NEAR(first.translation().norm(), 0.0600, 1e-4);
 }
 
 // ---- EuRoC ----------------------------------------------------------------------------------

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -95,6 +96,126 @@ TEST(GroundPlaneTest, NoEstimateWithoutAGround) {
   EXPECT_TRUE(EstimateGroundPlane(Road(1.65, PitchRoll(25, 0), -4, 4), options).valid);
   EXPECT_FALSE(EstimateGroundPlane(Road(-1.65, PitchRoll(0, 0), -4, 4)).valid);
   EXPECT_FALSE(EstimateGroundPlane({}).valid);
+}
+
+// A depth map of a flat road `height` below a camera rotated by `cam_from_level` (the rest, above
+// the horizon, invalid), at KITTI's size and intrinsics.
+cv::Mat RoadDepth(const Camera& camera, double height, const Eigen::Matrix3d& cam_from_level) {
+  cv::Mat depth(camera.height, camera.width, CV_32F, cv::Scalar(0));
+  const Eigen::Vector3d n = cam_from_level * Eigen::Vector3d(0, -1, 0);  // towards the camera
+  for (int r = 0; r < depth.rows; ++r) {
+    for (int c = 0; c < depth.cols; ++c) {
+      const Eigen::Vector3d ray((c - camera.cx) / camera.fx, (r - camera.cy) / camera.fy, 1.0);
+      const double along = -n.dot(ray);  // the ray meets the plane -n.X = height
+      if (along > 1e-6) depth.at<float>(r, c) = static_cast<float>(height / along);
+    }
+  }
+  return depth;
+}
+
+Camera Kitti() { return Camera::Pinhole(1241, 376, 718.856, 607.1928, 185.2157); }
+
+TEST(GroundPlaneTest, DenseRoadDepthGivesTheHeightAndNormal) {
+  const Camera camera = Kitti();
+  const Eigen::Matrix3d r = PitchRoll(1.5, -1);
+  const cv::Mat depth = RoadDepth(camera, 1.65, r);
+  const GroundPlane plane = EstimateGroundFromDepth(depth, camera);
+  ASSERT_TRUE(plane.valid);
+  EXPECT_NEAR(plane.height, 1.65, 1e-4);  // float depths
+  EXPECT_NEAR(plane.normal.dot(r * Eigen::Vector3d(0, -1, 0)), 1.0, 1e-8);
+  EXPECT_EQ(plane.inlier_share, 1.0);
+  EXPECT_LT(plane.height_sigma, 1e-3);
+  EXPECT_GT(plane.confidence, 0.9);
+  // Every candidate lies in the corridor; a box over the lane's pixels removes them.
+  const GroundFromDepthOptions options;
+  const auto all = RoadCandidates(depth, camera, {}, options);
+  for (const Eigen::Vector3d& p : all) {
+    EXPECT_LE(std::abs(p.x()), options.max_lateral);
+    EXPECT_GE(p.z(), options.min_depth);
+    EXPECT_LE(p.z(), options.max_depth);
+  }
+  const auto rest = RoadCandidates(depth, camera, {cv::Rect2d(0, 300, 1241, 76)}, options);
+  EXPECT_LT(rest.size(), all.size());
+  EXPECT_GT(rest.size(), all.size() / 4);
+  // Along a known normal: the same height, every point an inlier.
+  const GroundPlane along = GroundHeightAlong(all, r * Eigen::Vector3d(0, -1, 0));
+  ASSERT_TRUE(along.valid);
+  EXPECT_NEAR(along.height, 1.65, 1e-4);
+  EXPECT_EQ(along.num_inliers, static_cast<int>(all.size()));
+  // Along the level axis instead, the 1.5 degree pitch shows as a spread of heights.
+  const GroundPlane level = GroundHeightAlong(all, Eigen::Vector3d(0, -1, 0));
+  EXPECT_GT(level.residual_sigma, 0.02);
+  EXPECT_THROW(RoadCandidates(cv::Mat(10, 10, CV_32F), camera, {}, options), std::invalid_argument);
+  GroundFromDepthOptions bad;
+  bad.stride = 0;
+  EXPECT_THROW(RoadCandidates(depth, camera, {}, bad), std::invalid_argument);
+}
+
+// A textured road seen from two poses: the image of view `cam_from_level` with the road a
+// `height` below a level reference frame (x right, y down, z forward), the texture a smooth
+// function of the road's (x, z) and the sky grey.
+cv::Mat RenderRoad(const Camera& camera, double height, const Rigid3d& cam_from_level) {
+  cv::Mat image(camera.height, camera.width, CV_8UC1, cv::Scalar(128));
+  const Rigid3d level_from_cam = cam_from_level.inverse();
+  const Eigen::Vector3d centre = level_from_cam.translation();
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) {
+      const Eigen::Vector3d ray =
+          level_from_cam.linear() *
+          Eigen::Vector3d((c - camera.cx) / camera.fx, (r - camera.cy) / camera.fy, 1.0);
+      if (!(ray.y() > 1e-6)) continue;
+      const double s = (height - centre.y()) / ray.y();
+      const double x = centre.x() + s * ray.x(), z = centre.z() + s * ray.z();
+      const double v = 128 + 40 * std::sin(2.1 * x) * std::cos(1.3 * z) +
+                       30 * std::sin(0.7 * x + 2.9 * z) + 20 * std::cos(3.7 * z - 1.1 * x);
+      image.at<uint8_t>(r, c) = cv::saturate_cast<uint8_t>(v);
+    }
+  }
+  cv::GaussianBlur(image, image, cv::Size(3, 3), 0.8);
+  return image;
+}
+
+TEST(GroundPlaneTest, TwoViewsOfTheRoadGiveItsHeightInThePosesUnits) {
+  const Camera camera = Kitti();
+  // The rig pitched 1 degree down and rolled half a degree over a road 1.65 m below, moving
+  // 1.4 m forward (two KITTI frames) while turning 1 degree.
+  Rigid3d a_from_level = Rigid3d::Identity();
+  a_from_level.linear() = PitchRoll(1.0, 0.5);
+  Rigid3d b_from_a = Rigid3d::Identity();
+  b_from_a.linear() = Eigen::AngleAxisd(1.0 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  b_from_a.translation() = Eigen::Vector3d(0.02, 0.0, -1.4);
+  const cv::Mat a = RenderRoad(camera, 1.65, a_from_level);
+  const cv::Mat b = RenderRoad(camera, 1.65, b_from_a * a_from_level);
+  // Start level and 15 % high, as a network's reading would.
+  GroundPlane initial;
+  initial.height = 1.9;
+  const GroundPlane plane = EstimateGroundFromTwoViews(a, b, b_from_a, camera, initial);
+  ASSERT_TRUE(plane.valid);
+  EXPECT_NEAR(plane.height, 1.65, 0.005);
+  EXPECT_NEAR(plane.normal.dot(a_from_level.linear() * Eigen::Vector3d(0, -1, 0)), 1.0, 1e-4);
+  EXPECT_GT(plane.inlier_share, 0.95);
+  // In the map's units: the same poses at half scale give half the height.
+  Rigid3d half = b_from_a;
+  half.translation() *= 0.5;
+  initial.height = 0.95;
+  const GroundPlane scaled = EstimateGroundFromTwoViews(a, b, half, camera, initial);
+  ASSERT_TRUE(scaled.valid);
+  EXPECT_NEAR(scaled.height, 0.825, 0.0025);
+  // With the normal held at the true one, only the height is fitted.
+  TwoViewGroundOptions fixed;
+  fixed.fit_normal = false;
+  initial.height = 1.9;
+  initial.normal = a_from_level.linear() * Eigen::Vector3d(0, -1, 0);
+  const GroundPlane held = EstimateGroundFromTwoViews(a, b, b_from_a, camera, initial, {}, fixed);
+  ASSERT_TRUE(held.valid);
+  EXPECT_NEAR(held.height, 1.65, 0.005);
+  EXPECT_NEAR(held.normal.dot(initial.normal), 1.0, 1e-12);
+  // No motion, or a wall instead of a road (the sky's grey everywhere): no estimate.
+  EXPECT_FALSE(EstimateGroundFromTwoViews(a, b, Rigid3d::Identity(), camera, initial).valid);
+  const cv::Mat grey(camera.height, camera.width, CV_8UC1, cv::Scalar(128));
+  EXPECT_FALSE(EstimateGroundFromTwoViews(grey, grey, b_from_a, camera, initial).valid);
+  EXPECT_THROW(EstimateGroundFromTwoViews(a, cv::Mat(10, 10, CV_8UC1), b_from_a, camera, initial),
+               std::invalid_argument);
 }
 
 TEST(GroundPlaneTest, OptionsAreChecked) {

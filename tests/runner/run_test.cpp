@@ -1,11 +1,12 @@
 // The runner and the writer on a short synthetic office (walking persons, exact depth, truth
 // boxes): the report's per-frame records add up to its totals, the run folder holds every output
-// with the "ademono.run/1" summary, a second run (and one without prefetch) writes identical
-// trajectories, and a provider failure leaves no output.
+// with the "ademono.run/1" summary, a second run (one without prefetch, one preparing three
+// frames at once) writes identical trajectories, and a provider failure leaves no output.
 #include "ademono/runner/run.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <memory>
 #include <set>
@@ -57,12 +58,13 @@ class RunnerTest : public ::testing::Test {
     std::error_code ec;
     fs::remove_all(dir_, ec);
   }
-  static RunReport Run(bool overlap, bool truth = false) {
+  static RunReport Run(bool overlap, bool truth = false, int prefetch_frames = 1) {
     const auto sequence = OpenSequence("tum:" + (dir_ / "office").string());
     FrameDepth depth;
     TruthBoxes boxes(dir_ / "office" / "detections.jsonl");
     RunOptions options;
     options.pipeline.overlap = overlap;
+    options.pipeline.prefetch_frames = prefetch_frames;
     options.score_synthetic_truth = truth;
     options.config = "built-in";
     return RunSequence(*sequence, &depth, &boxes, options);
@@ -223,6 +225,21 @@ TEST_F(RunnerTest, SecondAndSequentialRunWritesIdenticalOutputs) {
   EXPECT_EQ(s1, s2);
 }
 
+// Three frames prepared at once (as a slow depth network gets two): the same outputs.
+TEST_F(RunnerTest, DeeperPrefetchWritesIdenticalOutputs) {
+  const fs::path a = dir_ / "a3", deep = dir_ / "deep";
+  WriteRunOutputs(*report_, a);
+  const RunReport third = Run(true, false, 3);
+  EXPECT_EQ(third.timing.at("extraction").thread, "prefetch");
+  WriteRunOutputs(third, deep);
+  for (const char* file :
+       {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map.ply", "groundtruth.tum"}) {
+    const std::string first = ReadText(a / file);
+    EXPECT_FALSE(first.empty()) << file;
+    EXPECT_EQ(first, ReadText(deep / file)) << file;
+  }
+}
+
 TEST_F(RunnerTest, ProviderFailureThrowsAndWritesNothing) {
   class FailsAtFrame5 : public FrameDepth {
    public:
@@ -232,10 +249,12 @@ TEST_F(RunnerTest, ProviderFailureThrowsAndWritesNothing) {
     }
   };
   const auto sequence = OpenSequence("tum:" + (dir_ / "office").string());
-  for (const bool overlap : {true, false}) {
+  for (const int prefetch : {1, 3, 0}) {  // 0: no overlap
+    const bool overlap = prefetch > 0;
     FailsAtFrame5 depth;
     RunOptions options;
     options.pipeline.overlap = overlap;
+    options.pipeline.prefetch_frames = std::max(1, prefetch);
     size_t frames_seen = 0;
     options.on_frame = [&](const FrameData&, const std::vector<Detection>&, const TrackResult&) {
       ++frames_seen;
@@ -243,7 +262,7 @@ TEST_F(RunnerTest, ProviderFailureThrowsAndWritesNothing) {
     const fs::path out = dir_ / "failed";
     EXPECT_THROW(WriteRunOutputs(RunSequence(*sequence, &depth, nullptr, options), out),
                  InputError);
-    EXPECT_EQ(frames_seen, 5u) << overlap;  // frames 0-4, in order, then the error
+    EXPECT_EQ(frames_seen, 5u) << prefetch;  // frames 0-4, in order, then the error
     EXPECT_FALSE(fs::exists(out));
   }
 }

@@ -53,6 +53,8 @@ std::string ToString(DepthModelSpec::Kind kind) {
       return "inverse";
     case DepthModelSpec::Kind::kDisparity:
       return "disparity";
+    case DepthModelSpec::Kind::kDisparityWidth:
+      return "disparity_width";
   }
   return "?";
 }
@@ -89,7 +91,11 @@ void DepthModelSpec::Check() const {
   if (kind == Kind::kDisparity && !(baseline_focal > 0)) {
     fail("output.baseline_focal must be positive for kind disparity");
   }
-  if (kind != Kind::kDisparity && !(scale > 0)) fail("output.scale must be positive");
+  if (kind == Kind::kDisparityWidth && !(baseline > 0)) {
+    fail("output.baseline must be positive for kind disparity_width");
+  }
+  if (kind != Kind::kDisparity && kind != Kind::kDisparityWidth && !(scale > 0))
+    fail("output.scale must be positive");
   if (canonical_focal > 0 && kind != Kind::kMetric) {
     fail("output.canonical_focal applies to kind metric only");
   }
@@ -153,9 +159,11 @@ const OptionsTable<DepthModelSpec>& DepthModelSpec::Table() {
                                  .AddChoice<Kind>("kind", &S::kind,
                                                   {{"metric", Kind::kMetric},
                                                    {"inverse", Kind::kInverse},
-                                                   {"disparity", Kind::kDisparity}})
+                                                   {"disparity", Kind::kDisparity},
+                                                   {"disparity_width", Kind::kDisparityWidth}})
                                  .Add("scale", &S::scale)
                                  .Add("baseline_focal", &S::baseline_focal)
+                                 .Add("baseline", &S::baseline)
                                  .Add("canonical_focal", &S::canonical_focal, Range::AtLeast(0))
                                  .Add("min_depth", &S::min_depth)
                                  .Add("max_depth", &S::max_depth);
@@ -236,7 +244,7 @@ void DepthModelSpec::InputGeometry(cv::Size image_size, cv::Size* input_size,
   }
 }
 
-double DepthModelSpec::ToDepth(double y, double focal_scale) const {
+double DepthModelSpec::ToDepth(double y, double focal_scale, double focal_over_width) const {
   switch (kind) {
     case Kind::kMetric:
       return scale * y * focal_scale;
@@ -244,6 +252,8 @@ double DepthModelSpec::ToDepth(double y, double focal_scale) const {
       return y > 0 ? scale / y : 0.0;
     case Kind::kDisparity:
       return y > 0 ? baseline_focal / y : 0.0;
+    case Kind::kDisparityWidth:
+      return y > 0 && focal_over_width > 0 ? baseline * focal_over_width / y : 0.0;
   }
   return 0.0;
 }

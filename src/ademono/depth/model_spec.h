@@ -29,8 +29,12 @@
 //     kind: metric         # metric: depth = scale * y
 //                          # inverse: depth = scale / y
 //                          # disparity: depth = baseline_focal / y (focal in pixels)
+//                          # disparity_width: y is a disparity as a fraction of the image
+//                          # width (PyDNet, Monodepth): depth = baseline * fx / (y * W), fx
+//                          # and W the original image's, so one spec serves every camera
 //     scale: 1.0
 //     baseline_focal: 0.0
+//     baseline: 0.0        # disparity_width: the stereo baseline trained on (m; KITTI 0.54)
 //     canonical_focal: 0   # > 0: Metric3D canonical camera, depth *= f_input / canonical_focal
 //                          # with f_input = fx scaled to the network input resolution
 //     min_depth: 0.0       # depths outside [min_depth, max_depth] become 0 (invalid)
@@ -62,7 +66,7 @@ class OptionsTable;
 
 struct DepthModelSpec {
   enum class Resize { kFixed, kLetterbox, kMultiple };
-  enum class Kind { kMetric, kInverse, kDisparity };
+  enum class Kind { kMetric, kInverse, kDisparity, kDisparityWidth };
 
   std::string name = "default";
   Resize resize = Resize::kFixed;
@@ -83,6 +87,7 @@ struct DepthModelSpec {
   Kind kind = Kind::kMetric;
   double scale = 1.0;
   double baseline_focal = 0.0;
+  double baseline = 0.0;  // disparity_width
   double canonical_focal = 0.0;
   double min_depth = 0.0;
   double max_depth = 1000.0;
@@ -104,8 +109,9 @@ struct DepthModelSpec {
   // Network input size for an image of `image_size`, and the size the image is scaled to
   // inside it (the rest is padding).
   void InputGeometry(cv::Size image_size, cv::Size* input_size, cv::Size* content_size) const;
-  // Output value -> metres (0 for invalid), before the valid-range check.
-  double ToDepth(double y, double focal_scale) const;
+  // Output value -> metres (0 for invalid), before the valid-range check. `focal_scale`:
+  // canonical-focal models' fx ratio; `focal_over_width`: fx / W of the image (disparity_width).
+  double ToDepth(double y, double focal_scale, double focal_over_width = 0.0) const;
 };
 
 std::string ToString(DepthModelSpec::Kind kind);

@@ -168,12 +168,20 @@ cv::Mat OnnxDepthProvider::DepthFromImage(const cv::Mat& image, const Camera& ca
     if (!(fx_image > 0)) throw std::invalid_argument("canonical-focal depth model needs fx > 0");
     focal_scale = fx_image * transform.scale_x / spec_.canonical_focal;
   }
+  // disparity_width: fx / W is the same at any resolution of the camera's image.
+  double focal_over_width = 0.0;
+  if (spec_.kind == DepthModelSpec::Kind::kDisparityWidth) {
+    focal_over_width = camera.width > 0 ? camera.fx / camera.width : 0.0;
+    if (!(focal_over_width > 0)) {
+      throw std::invalid_argument("disparity_width depth model needs the camera's fx and width");
+    }
+  }
   cv::Mat depth(image.size(), CV_32F);
   for (int r = 0; r < depth.rows; ++r) {
     const float* y = resized.ptr<float>(r);
     float* d = depth.ptr<float>(r);
     for (int c = 0; c < depth.cols; ++c) {
-      const double value = spec_.ToDepth(y[c], focal_scale);
+      const double value = spec_.ToDepth(y[c], focal_scale, focal_over_width);
       d[c] =
           std::isfinite(value) && value >= spec_.min_depth && value <= spec_.max_depth && value > 0
               ? static_cast<float>(value)

@@ -29,6 +29,7 @@ struct FileSequenceSpec {
   double depth_scale = 0.001;  // metres per depth-image unit
   bool has_depth = false;      // every frame has a depth file
   bool has_ground_truth = false;
+  std::optional<double> camera_height;  // Sequence::CameraHeight
 };
 
 class FileSequence : public Sequence {
@@ -44,6 +45,7 @@ class FileSequence : public Sequence {
   bool HasGroundTruth() const override { return spec_.has_ground_truth; }
   FrameData Load(size_t i) const override;
   double Timestamp(size_t i) const override;
+  std::optional<double> CameraHeight() const override { return spec_.camera_height; }
 
  private:
   FileSequenceSpec spec_;

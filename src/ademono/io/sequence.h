@@ -37,6 +37,9 @@ class Sequence {
   virtual FrameData Load(size_t i) const = 0;
   // Timestamp of frame i without decoding images.
   virtual double Timestamp(size_t i) const = 0;
+  // The camera's height above the road in metres when the dataset knows its rig (KITTI: 1.65 m),
+  // for the ground-plane scale (depth.camera_height, which overrides it).
+  virtual std::optional<double> CameraHeight() const { return std::nullopt; }
 };
 
 // "tum:DIR", "kitti:DIR", "euroc:DIR", "7scenes:DIR", "folder:DIR", "video:FILE", "camera:N" or

@@ -1,6 +1,8 @@
 // KITTI odometry: DIR/image_0 (grey left) or DIR/image_2 (colour left), calib.txt with P0/P2
 // (3x4 projection: fx, cx, fy, cy), times.txt (seconds per frame), ground truth poses/NN.txt
 // (NN = DIR's name) in DIR, DIR/.., or DIR/../.. (the official dataset/poses/ layout).
+// The KITTI rig's camera height above the road (1.65 m) comes with the calibration
+// (Sequence::CameraHeight), not with a --camera YAML (another rig).
 #include <algorithm>
 
 #include "ademono/core/error.h"
@@ -15,8 +17,12 @@ namespace ademono {
 namespace {
 
 constexpr double kKittiFps = 10.0;
+// The cameras' height above the road on the KITTI recording car (Geiger et al., IJRR 2013).
+constexpr double kKittiCameraHeight = 1.65;
 
-Camera ReadKittiCalib(const fs::path& calib, const std::string& key) {
+// The camera of line `key` and, in `cam_from_cam0`, its offset from camera 0 (whose poses
+// poses/NN.txt gives): the rectified projection is P = K [I | t], so t = K^-1 P(:, 3).
+Camera ReadKittiCalib(const fs::path& calib, const std::string& key, Eigen::Vector3d* cam_from_cam0) {
   std::optional<Camera> camera;
   ForEachDataLine(calib, false, [&](size_t line, const std::vector<std::string_view>& f) {
     if (f.front() != key + ":") return;
@@ -32,6 +38,10 @@ Camera ReadKittiCalib(const fs::path& calib, const std::string& key) {
     c.fy = p[5];
     c.cy = p[6];
     camera = c;
+    const double tz = p[11];
+    const double ty = (p[7] - c.cy * tz) / c.fy;
+    const double tx = (p[3] - c.cx * tz - p[1] * ty) / c.fx;
+    *cam_from_cam0 = Eigen::Vector3d(tx, ty, tz);
   });
   if (!camera) ThrowInputError(calib, "has no " + key + " line");
   return *camera;
@@ -94,17 +104,17 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& dir,
     }
     spec.has_ground_truth = true;
   }
-  for (size_t i = 0; i < images.size(); ++i) {
-    FileFrame frame{times[i], images[i], {}, std::nullopt};
-    if (!poses.empty()) frame.world_from_cam_gt = poses[i].world_from_cam;
-    spec.frames.push_back(std::move(frame));
-  }
-
+  // The ground truth is camera 0's (the left grey camera); the colour camera sits 6 cm to its
+  // left: its poses are camera 0's moved by the calibration's offset.
+  Rigid3d cam0_from_cam = Rigid3d::Identity();
   if (camera_yaml) {
     spec.camera = LoadCameraYaml(*camera_yaml);
   } else {
     const fs::path calib = dir / "calib.txt";
-    spec.camera = ReadKittiCalib(calib, grey ? "P0" : "P2");
+    Eigen::Vector3d cam_from_cam0 = Eigen::Vector3d::Zero();
+    spec.camera = ReadKittiCalib(calib, grey ? "P0" : "P2", &cam_from_cam0);
+    cam0_from_cam.translation() = -cam_from_cam0;
+    spec.camera_height = kKittiCameraHeight;
     const cv::Size size = ImageSizeOf(images.front());
     spec.camera.width = size.width;
     spec.camera.height = size.height;
@@ -113,6 +123,11 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& dir,
     } catch (const std::invalid_argument& e) {
       ThrowInputError(calib, e.what());
     }
+  }
+  for (size_t i = 0; i < images.size(); ++i) {
+    FileFrame frame{times[i], images[i], {}, std::nullopt};
+    if (!poses.empty()) frame.world_from_cam_gt = poses[i].world_from_cam * cam0_from_cam;
+    spec.frames.push_back(std::move(frame));
   }
   return std::make_unique<FileSequence>(std::move(spec));
 }

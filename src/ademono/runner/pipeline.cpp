@@ -1,6 +1,7 @@
 #include "ademono/runner/pipeline.h"
 
 #include <algorithm>
+#include <deque>
 #include <future>
 #include <optional>
 #include <utility>
@@ -90,7 +91,9 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   PipelineResult result;
   const size_t end = std::min(options.end, sequence.Size());
   const auto wall_start = Now();
-  std::future<Prepared> next;
+  // Preparations in flight, in frame order: the front is the next frame to track.
+  std::deque<std::future<Prepared>> ahead;
+  const size_t depth_ahead = static_cast<size_t>(std::max(1, options.prefetch_frames));
   // Extraction beside depth and detection only when they are real work (a network or a
   // detector); a sensor depth map costs nothing to hide behind.
   const bool parallel_extraction =
@@ -109,7 +112,7 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
       r = system.TrackFrame(current.frame, current.depth, current.detections,
                             std::move(current.extracted));
     } catch (...) {
-      if (next.valid()) next.wait();  // never leave the worker running on a dying pipeline
+      for (auto& f : ahead) f.wait();  // never leave a worker running on a dying pipeline
       throw;
     }
     FrameTiming t;
@@ -144,24 +147,34 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
       track(current, current.cpu_ms, 0, false);
     }
   } else {
+    size_t launched = options.start + 1;  // the next frame to hand to a worker
     for (size_t i = options.start; i < end && !stop_requested(); ++i) {
       Prepared current;
       double inline_cpu = 0, wait_ms = 0;
-      const bool prefetched = options.overlap && next.valid();
+      const bool prefetched = options.overlap && !ahead.empty();
       if (prefetched) {
         const auto wait_start = Now();
-        current = next.get();  // rethrows a provider's InputError here, in frame order
+        std::future<Prepared> front = std::move(ahead.front());
+        ahead.pop_front();
+        try {
+          current = front.get();  // rethrows a provider's InputError here, in frame order
+        } catch (...) {
+          for (auto& f : ahead) f.wait();
+          throw;
+        }
         wait_ms = MsSince(wait_start);
       } else {
         current = Prepare(sequence, depth, detector, system, false, i);
         inline_cpu = current.cpu_ms - current.decode_cpu_ms;  // the tracking thread: decode excluded
       }
-      if (options.overlap && i + 1 < end) {
-        next = std::async(std::launch::async, Prepare, std::cref(sequence), depth, detector,
-                          std::cref(system), parallel_extraction, i + 1);
+      while (options.overlap && launched < end && launched <= i + depth_ahead) {
+        ahead.push_back(std::async(std::launch::async, Prepare, std::cref(sequence), depth,
+                                   detector, std::cref(system), parallel_extraction, launched));
+        ++launched;
       }
       track(current, inline_cpu, wait_ms, prefetched);
     }
+    for (auto& f : ahead) f.wait();  // stopped early: let the workers finish
   }
   result.wall_seconds = MsSince(wall_start) / 1000.0;
   return result;
