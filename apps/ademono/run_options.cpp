@@ -147,7 +147,6 @@ void ApplyDepthSource(const std::string& depth_arg, SystemOptions& options) {
     options.tracking.monocular = true;
     options.depth.error_relative = 0;
     options.depth.error_per_metre = 0;
-    options.depth.camera_height = 0;
     // The enhancement walk is weighted by depth: without depth it would only drop keypoints.
     options.filter.enable_enhancement = false;
     return;

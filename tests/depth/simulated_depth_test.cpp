@@ -150,7 +150,7 @@ TEST(SimulatedDepth, FactorySpecAndErrors) {
   };
   EXPECT_EQ(message("simulated:foo=1"),
             "depth provider 'simulated': unknown parameter 'foo' (expected scale, a, b, pixel, "
-            "edge_blur, invalid, jitter, jitter_frames, seed, gt)");
+            "edge_blur, invalid, jitter, jitter_frames, shift, shift_jitter, seed, gt)");
   EXPECT_EQ(message("simulated:scale=abc"),
             "depth provider 'simulated': 'scale=abc' is not a number");
   EXPECT_EQ(message("simulated:invalid=1.5"),

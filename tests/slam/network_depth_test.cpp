@@ -97,13 +97,15 @@ TEST(NetworkDepthTest, ScaleCorrectionRecoversEachFramesScaleAndAnchorsTheMap) {
   EXPECT_LT(result.ape.rmse, 0.05);
 }
 
-// tracking.mapped_place_ratio (configs/network_indoor.yaml): on a place mapped already, the
+// tracking.mapped_place_ratio (configs/ablation/network_prior_indoor.yaml: the network as a
+// per-point prior, where the close-point keyframe rule exists): on a place mapped already, the
 // close-point rule must not make a keyframe on nearly every frame. The camera goes back and
 // forth over the first 40 frames of the office path (as the soak benchmark does over 300,
 // bench/soak_bench.cpp); in the fourth pass (a revisit) the unchecked rule (ratio 0) made a
 // keyframe on 37 of its 39 frames, the shipped 0.8 on 1.
 TEST(NetworkDepthTest, RevisitedPlaceMakesFewKeyframes) {
-  const std::string path = std::string(ADEMONO_SOURCE_DIR) + "/configs/network_indoor.yaml";
+  const std::string path =
+      std::string(ADEMONO_SOURCE_DIR) + "/configs/ablation/network_prior_indoor.yaml";
   SystemOptions options = SystemOptions::FromYaml(YAML::LoadFile(path), path);
   ASSERT_GT(options.tracking.mapped_place_ratio, 0.0);
   options.orb.num_features = 1000;

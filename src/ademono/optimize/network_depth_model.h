@@ -32,6 +32,12 @@ struct InverseDepthAffine {
   // Robust scale of the network against the map: the median of z_net / z_map.
   double median_ratio = 1.0;
 
+  // The same model after the map's lengths were multiplied by `factor`.
+  void Rescale(double factor) {
+    a /= factor;
+    b /= factor;
+    median_ratio /= factor;
+  }
   // The network's depth `z_net` in map units (0 if the map sends it behind the camera).
   double Map(double z_net) const {
     const double inv = a / z_net + b;

@@ -202,6 +202,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   report.trajectory = system.FrameTrajectory();
   report.keyframe_trajectory = system.KeyFrameTrajectory();
   report.ground_heights = system.GroundHeights();
+  report.ground_height_frames = system.GroundHeightFrames();
   if (options.system.depth.IsPrior() || options.system.depth.GroundScale()) {
     std::map<size_t, double> scales;
     for (const auto& [index, scale] : system.DepthScales()) scales[index] = scale;
@@ -304,9 +305,17 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     // The map's scale from the known camera height: how often the ground was found and the
     // camera's median height above it in the final map (camera_height when it worked; the
     // scale it gave the depths is depth_scale).
+    nlohmann::json per_keyframe = nlohmann::json::array();
+    for (size_t k = 0; k < report.ground_heights.size(); ++k) {
+      per_keyframe.push_back({{"frame", k < report.ground_height_frames.size()
+                                            ? report.ground_height_frames[k]
+                                            : 0},
+                              {"height", report.ground_heights[k]}});
+    }
     j["ground_scale"] = {{"camera_height", o.depth.camera_height},
                          {"estimates", report.ground_heights.size()},
-                         {"map_height", Median(report.ground_heights)}};
+                         {"map_height", Median(report.ground_heights)},
+                         {"per_keyframe", per_keyframe}};
   }
   nlohmann::json per_frame = nlohmann::json::array();
   for (const FrameReport& f : report.per_frame) {

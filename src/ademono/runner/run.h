@@ -111,6 +111,7 @@ struct RunReport {
   size_t frames = 0, keyframes = 0, map_points = 0;
   int lost = 0;
   std::vector<double> ground_heights;  // depth.camera_height: System::GroundHeights
+  std::vector<size_t> ground_height_frames;  // ... and where each was measured
   double wall_seconds = 0;
   // Stopped early (options.pipeline.stop, e.g. Ctrl-C): the report covers the frames done so far.
   bool partial = false;

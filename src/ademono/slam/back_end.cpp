@@ -272,6 +272,11 @@ std::vector<double> BackEnd::GroundHeights() const {
   return tracking_.GroundHeights();
 }
 
+std::vector<size_t> BackEnd::GroundHeightFrames() const {
+  MutexLock lock(map_.mutex);
+  return tracking_.GroundHeightFrames();
+}
+
 int BackEnd::NumTracked() const {
   int n = 0;
   for (const FrameRecord& r : tracking_.Records()) n += r.tracked ? 1 : 0;

@@ -84,6 +84,7 @@ class BackEnd {
   int NumLost() const;
   // depth.camera_height: the camera heights measured above the ground (Tracking::GroundHeights).
   std::vector<double> GroundHeights() const;
+  std::vector<size_t> GroundHeightFrames() const;  // Tracking::GroundHeightFrames
   int NumTracked() const;
 
  private:

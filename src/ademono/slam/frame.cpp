@@ -167,11 +167,11 @@ ImageObservation FrameFeatures::Observation(size_t i) const {
   return o;
 }
 
-ImageObservation FrameFeatures::PriorObservation(size_t i) const {
+ImageObservation FrameFeatures::PriorObservation(size_t i, double z, double sigma_z) const {
   ImageObservation o = Observation(i);
-  const double z = depth[i];
   o.u_right = keypoints_un[i].pt.x - intrinsics.bf / z;
-  if (depth_error.Enabled() && z > 0) o.depth_inv_sigma = z * z / (intrinsics.bf * depth_error.Sigma(z));
+  // sigma(u_right) = bf * sigma_z / z^2 for u_right = u - bf / z.
+  if (sigma_z > 0) o.depth_inv_sigma = z * z / (intrinsics.bf * sigma_z);
   return o;
 }
 

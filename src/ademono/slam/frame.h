@@ -62,9 +62,9 @@ struct FrameFeatures {
     return u >= min_x && u < max_x && v >= min_y && v < max_y;
   }
   ImageObservation Observation(size_t i) const;
-  // Keypoint i with its depth as a 3-dof (u, v, u_right) observation weighted by the error model,
-  // also in monocular mode (a network depth prior); requires depth[i] > 0.
-  ImageObservation PriorObservation(size_t i) const;
+  // Keypoint i with a depth prior `z` of standard deviation `sigma_z` as a 3-dof
+  // (u, v, u_right) observation, also in monocular mode (a network depth prior); z > 0.
+  ImageObservation PriorObservation(size_t i, double z, double sigma_z) const;
   // Camera-frame point of keypoint i from its depth (requires depth[i] > 0).
   Eigen::Vector3d UnprojectCamera(size_t i) const;
   bool IsClose(size_t i) const { return depth[i] > 0 && depth[i] < close_depth; }

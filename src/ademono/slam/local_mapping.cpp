@@ -131,7 +131,8 @@ void LocalMapping::Merge() {
     MutexLock lock(map_.mutex);
     if (pending->has_ba) {
       ApplyBundleAdjustment(*pending);
-      if (monocular_ && configured_sigma_log_ > 0) MeasureNetworkErrors(*pending);
+      if (monocular_ && configured_sigma_log_ > 0 && options_.network_error_model)
+        MeasureNetworkErrors(*pending);
     }
     CullKeyFrames(*pending->keyframe);
     const double cull_ms = MsSinceStart(start);
@@ -420,11 +421,11 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         auto it = camera_index.find(kf);
         if (it == camera_index.end()) continue;
         // The network's depth holds the point only where geometry cannot yet.
-        const bool prior = monocular_ && p->depth_prior && kf == p->reference &&
-                           kf->F().depth[idx] > 0 && PriorActive(*p);
-        problem.observations.push_back({it->second, point_index,
-                                        prior ? kf->F().PriorObservation(idx)
-                                              : kf->F().Observation(idx)});
+        const bool prior = monocular_ && options_.network_priors && p->depth_prior &&
+                           kf == p->reference && kf->F().depth[idx] > 0 && PriorActive(*p);
+        problem.observations.push_back(
+            {it->second, point_index,
+             prior ? NetworkPrior(*kf, idx) : kf->F().Observation(idx)});
         observation_refs.emplace_back(kf, idx);
       }
     }
@@ -491,8 +492,19 @@ void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
   }
 }
 
+ImageObservation LocalMapping::NetworkPrior(const KeyFrame& kf, size_t i) const {
+  const FrameFeatures& f = kf.F();
+  double z = f.depth[i];
+  // The keyframe's own error model once it has one: the network's reading mapped into the map.
+  if (options_.network_error_model && kf.network_fit.valid) {
+    const double mapped = kf.network_fit.Map(f.depth[i] / f.depth_scale);
+    if (mapped > 0) z = mapped;
+  }
+  return f.PriorObservation(i, z, NetworkSigmaLog() * z);
+}
+
 double LocalMapping::NetworkSigmaLog() const {
-  if (sigma_logs_.empty()) return configured_sigma_log_;
+  if (sigma_logs_.empty() || !options_.network_error_model) return configured_sigma_log_;
   // The recent keyframes' (the network's error depends on the scene it sees).
   constexpr size_t kRecent = 20;
   const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;

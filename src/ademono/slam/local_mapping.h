@@ -62,6 +62,9 @@ class LocalMapping {
   // after each keyframe's affine map, InverseDepthAffine::sigma_log) measured so far against
   // triangulated points, or the configured error model's until there is a measurement.
   double NetworkSigmaLog() const;
+  // Monocular core with a network: keypoint i of `kf` with its network depth as a prior
+  // observation (the keyframe's fitted error model applied when it has one).
+  ImageObservation NetworkPrior(const KeyFrame& kf, size_t i) const ADEMONO_REQUIRES(map_.mutex);
   // Monocular core with a network: whether point `p`'s network-depth prior still enters local BA
   // (geometry's depth of it less certain than the network's: too little parallax).
   bool PriorActive(const MapPoint& p) const ADEMONO_REQUIRES(map_.mutex);

@@ -651,8 +651,10 @@ void LoopClosing::Correct(KeyFrame& query, const Verified& loop, LoopEvent& even
     const Sim3d& g = solved.cam_from_world[k];
     kf->cam_from_world = g.ToRigid();
     // A network depth prior is metric in the keyframe's camera: points there shrank by 1/s.
-    if (kf->F().DepthIsPrior() && std::abs(g.scale - 1.0) > 1e-12)
+    if (kf->F().DepthIsPrior() && std::abs(g.scale - 1.0) > 1e-12) {
       kf->features = RescaleDepth(kf->F(), static_cast<float>(1.0 / g.scale));
+      if (kf->network_fit.valid) kf->network_fit.Rescale(1.0 / g.scale);
+    }
   }
   for (const auto& [id, p] : map_.MapPoints()) {
     if (!p->bad) p->UpdateNormalAndDepth();

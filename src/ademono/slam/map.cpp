@@ -166,6 +166,7 @@ void Map::Rescale(double factor) {
     kf.cam_from_parent.translation() *= factor;
     // The keyframe's depths too: local BA's depth residuals would pull the map back.
     kf.features = RescaleDepth(kf.F(), static_cast<float>(factor));
+    if (kf.network_fit.valid) kf.network_fit.Rescale(factor);
   };
   for (auto& [id, kf] : keyframes_) rescale_keyframe(*kf);
   for (auto& kf : graveyard_) rescale_keyframe(*kf);

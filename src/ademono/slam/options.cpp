@@ -44,7 +44,9 @@ const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
                                      Range::Above(0))
                                 .Add("ground_min_inliers", &D::ground_min_inliers,
                                      Range::AtLeast(3))
-                                .Add("ground_tolerance", &D::ground_tolerance, Range::AtLeast(0));
+                                .Add("ground_tolerance", &D::ground_tolerance, Range::AtLeast(0))
+                                .Add("ground_min_parallax_deg", &D::ground_min_parallax_deg,
+                                     Range::AtLeast(0));
   return table;
 }
 
@@ -127,6 +129,8 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
           .Add("triangulation_min_parallax_deg", &M::triangulation_min_parallax_deg,
                Range::ClosedOpen(0, 90))
           .Add("triangulation_depth_sigmas", &M::triangulation_depth_sigmas, Range::AtLeast(0))
+          .Add("network_priors", &M::network_priors)
+          .Add("network_error_model", &M::network_error_model)
           .Add("triangulation_match_ratio", &M::triangulation_match_ratio,
                Range::OpenClosed(0, 1))
           .Add("triangulation_min_baseline_ratio", &M::triangulation_min_baseline_ratio,

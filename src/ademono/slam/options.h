@@ -73,6 +73,9 @@ struct FrameDepthOptions {
   // a plane tilted to take them in too reads the height several per cent off.
   double ground_max_depth = 25.0;
   double ground_max_lateral = 4.0;
+  // Monocular core: a network-placed map point measures the ground only once two of its views
+  // are this far apart (triangulated, not the network's reading of the road).
+  double ground_min_parallax_deg = 1.0;
   double ground_max_tilt_deg = 15.0;  // the ground's normal within this of the camera's up axis
   double ground_inlier_ratio = 0.05;  // inliers within this fraction of the height
   int ground_min_inliers = 50;
@@ -190,6 +193,13 @@ struct MappingOptions {
   // of its median scene depth (ORB-SLAM's 0.01); the monocular core makes no keyframe (unless
   // tracking is weak) before the frame is that far from its reference keyframe.
   double triangulation_min_baseline_ratio = 0.01;
+  // Monocular core with a network (tracking.monocular, depth with an error model): a point made
+  // from the network's depth keeps it as a prior in local BA while its parallax leaves geometry
+  // less certain (network_priors); each keyframe's network error is fitted against its
+  // triangulated points (an affine map in inverse depth) and the measured spread replaces the
+  // configured error model (network_error_model). Off: the ablation of each.
+  bool network_priors = true;
+  bool network_error_model = true;
   BundleAdjustmentOptions ba;  // keys ba_first_iterations, ba_second_iterations
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);

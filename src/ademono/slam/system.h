@@ -109,6 +109,8 @@ class System {
   // depth.camera_height: the camera heights above the ground plane measured so far, in the
   // map's units (Tracking::GroundHeights).
   std::vector<double> GroundHeights() const;
+  // The input frame index of each GroundHeights() entry (a keyframe's, or the first frame's).
+  std::vector<size_t> GroundHeightFrames() const { return back_end_.GroundHeightFrames(); }
   int NumTracked() const;
   const Camera& GetCamera() const { return camera_; }
   const SystemOptions& Options() const { return options_; }

@@ -123,7 +123,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   geometric_culled_ = 0;
 
   if (state_ == TrackingState::kNotInitialized) {
-    if (options_.depth.GroundScale() && ground_heights_.empty()) {
+    // The monocular core measures the ground on the map's own (triangulated) points only: a
+    // network's reading of the road is distorted (PyDNet's rises ahead, docs/kitti.md).
+    if (options_.depth.GroundScale() && ground_heights_.empty() && !options_.tracking.monocular) {
       // The first map is made at the ground's scale, measured on the frame's own depths
       // (nothing to rescale yet).
       if (const std::optional<double> height = MeasureGround(frame, false)) {
@@ -131,6 +133,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         frame.features = RescaleDepth(frame.F(), static_cast<float>(factor));
         last_depth_scale_ = frame.F().depth_scale;
         ground_heights_.push_back(*height * factor);
+        ground_height_frames_.push_back(index);
       }
     }
     if (options_.tracking.monocular &&
@@ -228,6 +231,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       }
     }
 
+    // A diverged optimisation is a lost frame, never a pose.
+    if (ok && (!frame.cam_from_world || !frame.cam_from_world->matrix().allFinite())) ok = false;
     if (ok) {
       if (out.quality == PoseQuality::kMotionModel ||
           (weak && !options_.tracking.weak_pose_sets_velocity)) {
@@ -247,8 +252,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
         if (options_.depth.GroundScale() && !map_loaded_) {
-          if (const std::optional<double> height = MeasureGround(frame, true))
+          if (const std::optional<double> height = MeasureGround(frame, true)) {
             ground_heights_.push_back(*height);
+            ground_height_frames_.push_back(index);
+          }
         }
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame, &out.created_points);
@@ -424,6 +431,9 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
     // streams past: 30-50 against 200 keypoints with depth).
     for (const auto& point : local_points_) {
       if (!point || point->bad || !UsableForPose(*point)) continue;
+      // A point the network placed counts only once other views have triangulated it: the
+      // network's road rises ahead, and the first map is all network (KITTI: 12 m "heights").
+      if (point->depth_prior && !Triangulated(*point)) continue;
       add(*frame.cam_from_world * point->position);
     }
   } else {
@@ -439,6 +449,18 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
   const GroundPlane plane = EstimateGroundPlane(points, options);
   if (!plane.valid) return std::nullopt;
   return plane.height;
+}
+
+bool Tracking::Triangulated(const MapPoint& point) const {
+  const KeyFrame* ref = point.reference;
+  if (ref == nullptr || ref->bad) return false;
+  const Eigen::Vector3d ray_ref = (point.position - ref->CameraCenter()).normalized();
+  const double min_cos = std::cos(options_.depth.ground_min_parallax_deg * M_PI / 180.0);
+  for (const auto& [kf, idx] : point.observations) {
+    if (kf == ref || kf->bad) continue;
+    if ((point.position - kf->CameraCenter()).normalized().dot(ray_ref) < min_cos) return true;
+  }
+  return false;
 }
 
 void Tracking::RescaleWorld(Frame& frame, double factor) {
@@ -826,7 +848,10 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
     return false;
   }
   if (reference_keyframe_ == nullptr) return true;
-  const int min_obs = t.keyframe_ref_min_observations > 0 ? t.keyframe_ref_min_observations
+  // Monocular: a map of one keyframe (made from depth) has only single-view points; they count
+  // (else no keyframe would ever come: RGB-D has the close-point rule for that).
+  const int min_obs = t.keyframe_ref_min_observations > 0    ? t.keyframe_ref_min_observations
+                      : t.monocular && map_.NumKeyFrames() <= 1 ? 1
                       : map_.NumKeyFrames() <= 2          ? 2
                                                           : 3;
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);

@@ -113,6 +113,8 @@ class Tracking {
   // and at every keyframe, in the map's current units (the map is rescaled whenever their
   // median strays from camera_height by more than depth.anchor_tolerance).
   const std::vector<double>& GroundHeights() const { return ground_heights_; }
+  // The input frame index of each GroundHeights() entry.
+  const std::vector<size_t>& GroundHeightFrames() const { return ground_height_frames_; }
   // For the analysis (core/thread_annotations.h): the caller holds the map's mutex under another
   // name (its own reference to the map). Checked at run time.
   void AssertMapHeld() const ADEMONO_ASSERT_CAPABILITY(map_.mutex) { map_.mutex.AssertHeld(); }
@@ -172,6 +174,8 @@ class Tracking {
   // own depths (the source's units, before any correction; for the first map).
   std::optional<double> MeasureGround(const Frame& frame, bool map_points) const
       ADEMONO_REQUIRES(map_.mutex);
+  // Whether two of the point's views are at least depth.ground_min_parallax_deg apart.
+  bool Triangulated(const MapPoint& point) const ADEMONO_REQUIRES(map_.mutex);
   // Multiplies every length of the map and of the tracker's state by `factor`.
   void RescaleWorld(Frame& frame, double factor) ADEMONO_REQUIRES(map_.mutex);
 
@@ -199,6 +203,7 @@ class Tracking {
   double log_scale_sum_ = 0.0;     // sum of log(depth_scale) over tracked frames
   int log_scale_count_ = 0;
   std::vector<double> ground_heights_;  // depth.camera_height: GroundHeights()
+  std::vector<size_t> ground_height_frames_;
   bool map_loaded_ = false;
   bool localize_only_ = false;
   // Localisation only without a temporary map (tracking.temporary_map false): frame-to-frame
