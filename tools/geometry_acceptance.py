@@ -205,6 +205,7 @@ def main():
                 (r, "no_scale_anchor", ["--set", "depth.anchor_scale=false",
                                         "--set", "depth.camera_height=0"]),
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
+                (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
             ]
     folders = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:

@@ -199,3 +199,68 @@ TEST(BundleAdjustmentTest, ProblemFileRoundTripsAndRejectsBadFiles) {
 
 }  // namespace
 }  // namespace ademono
+
+namespace ademono {
+namespace {
+
+// A monocular window (no depth observations) leaves the scale free; three cameras 1.5 m above a
+// road, each holding the road points it sees at that height, fix it. The start is the truth
+// scaled by 1.25 about the fixed first camera, which every reprojection fits exactly.
+TEST(BundleAdjustmentTest, PlaneDistancesFixTheScaleAMonocularWindowLeavesFree) {
+  std::mt19937 rng(11);
+  const double height = 1.5, start_scale = 1.25;
+  BundleAdjustmentProblem problem;
+  problem.intrinsics = kIntrinsics;
+  std::vector<Rigid3d> truth;
+  for (int c = 0; c < 3; ++c) {
+    Rigid3d world_from_cam = Rigid3d::Identity();
+    world_from_cam.translation() = Eigen::Vector3d(0.05 * c, 0, 0.8 * c);
+    truth.push_back(world_from_cam.inverse());
+    Rigid3d start = truth.back();
+    start.translation() *= start_scale;
+    problem.cameras.push_back({start, c == 0});
+  }
+  std::uniform_real_distribution<double> x(-3, 3), y(-2, 1), z(6, 15);
+  std::normal_distribution<double> pixel_noise(0, 0.3);
+  std::vector<Eigen::Vector3d> points;
+  for (int p = 0; p < 200; ++p) {
+    // Every other point on the road (y = height below every camera: they move level).
+    points.emplace_back(x(rng), p % 2 == 0 ? height : y(rng), z(rng));
+    problem.points.push_back(start_scale * points.back());
+  }
+  for (size_t p = 0; p < points.size(); ++p) {
+    for (size_t c = 0; c < 3; ++c) {
+      const Eigen::Vector3d pc = truth[c] * points[p];
+      ImageObservation o;
+      o.pixel = Eigen::Vector2d(kIntrinsics.fx * pc.x() / pc.z() + kIntrinsics.cx,
+                                kIntrinsics.fy * pc.y() / pc.z() + kIntrinsics.cy);
+      o.pixel += Eigen::Vector2d(pixel_noise(rng), pixel_noise(rng));
+      problem.observations.push_back({c, p, o});
+    }
+  }
+  auto scale_of = [&](const BundleAdjustmentResult& r) {
+    double sum = 0;
+    for (size_t p = 0; p < points.size(); ++p) sum += r.points[p].norm() / points[p].norm();
+    return sum / points.size();
+  };
+  EXPECT_NEAR(scale_of(SolveBundleAdjustment(problem)), start_scale, 0.02)
+      << "reprojection alone must leave the scale where it was";
+
+  for (size_t c = 0; c < 3; ++c) {
+    for (size_t p = 0; p < points.size(); p += 2) {
+      problem.plane_distances.push_back({c, p, Eigen::Vector3d(0, -1, 0), -height, 1 / 0.075});
+    }
+  }
+  BundleAdjustmentOptions options;
+  options.first_iterations = 20;
+  options.second_iterations = 20;
+  const BundleAdjustmentResult held = SolveBundleAdjustment(problem, options);
+  EXPECT_NEAR(scale_of(held), 1.0, 0.01);
+  EXPECT_NEAR(held.cam_from_world[2].inverse().translation().z(), 1.6, 0.02);
+
+  problem.plane_distances.push_back({3, 0, Eigen::Vector3d(0, -1, 0), -height, 1});
+  EXPECT_THROW(SolveBundleAdjustment(problem), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ademono

@@ -43,6 +43,20 @@ ceres::CostFunction* MakeCost(const BundleAdjustmentOptions& options,
       new internal::BaResidual<kDim>(intrinsics, image));
 }
 
+struct PlaneDistanceResidual {
+  explicit PlaneDistanceResidual(const BaPlaneDistance& d) : d(d) {}
+  template <typename T>
+  bool operator()(const T* camera, const T* point, T* residual) const {
+    T q[3];
+    ceres::AngleAxisRotatePoint(camera, point, q);
+    T along = T(0);
+    for (int k = 0; k < 3; ++k) along += T(d.normal_cam[k]) * (q[k] + camera[3 + k]);
+    residual[0] = T(d.inv_sigma) * (along - T(d.distance));
+    return true;
+  }
+  BaPlaneDistance d;
+};
+
 // Solves with the observations not flagged in `skip`; returns whether Ceres converged.
 bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
            const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
@@ -67,6 +81,14 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
     camera_used[o.camera] = true;
   }
   if (ceres_problem.NumResidualBlocks() == 0) return false;
+  // Only on points and cameras the observations keep: the plane never holds an outlier's point.
+  for (const BaPlaneDistance& d : problem.plane_distances) {
+    if (!point_used[d.point] || !camera_used[d.camera]) continue;
+    ceres_problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<PlaneDistanceResidual, 1, 6, 3>(
+            new PlaneDistanceResidual(d)),
+        new ceres::HuberLoss(1.0), &cameras[6 * d.camera], &points[3 * d.point]);
+  }
   for (size_t c = 0; c < problem.cameras.size(); ++c) {
     if (!camera_used[c]) continue;
     if (problem.cameras[c].fixed) ceres_problem.SetParameterBlockConstant(&cameras[6 * c]);
@@ -130,6 +152,11 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
   for (const BaObservation& o : problem.observations) {
     if (o.camera >= problem.cameras.size() || o.point >= problem.points.size()) {
       throw std::invalid_argument("bundle adjustment: observation index out of range");
+    }
+  }
+  for (const BaPlaneDistance& d : problem.plane_distances) {
+    if (d.camera >= problem.cameras.size() || d.point >= problem.points.size()) {
+      throw std::invalid_argument("bundle adjustment: plane distance index out of range");
     }
   }
   std::vector<double> cameras(6 * problem.cameras.size()), points(3 * problem.points.size());

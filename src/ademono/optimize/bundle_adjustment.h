@@ -46,6 +46,20 @@ struct BaObservation {
   ImageObservation image;
 };
 
+// A point on a plane of known distance from a camera (the road under a vehicle's camera, at the
+// rig's height): residual inv_sigma * (normal . (R X + t) - distance), Huber at one sigma. This
+// is how a known camera height holds the local map's scale in every window, where a global
+// rescale cannot undo drift (docs/slam.md "Scale from the camera height").
+struct BaPlaneDistance {
+  size_t camera = 0;
+  size_t point = 0;
+  Eigen::Vector3d normal_cam = Eigen::Vector3d(0, -1, 0);  // unit, in the camera's frame
+  // normal . X_cam the point should have (minus the camera height, for a road point and a
+  // normal pointing from the road to the camera)
+  double distance = 0.0;
+  double inv_sigma = 1.0;
+};
+
 struct BundleAdjustmentProblem {
   PinholeIntrinsics intrinsics;
   std::vector<BaCamera> cameras;
@@ -53,6 +67,7 @@ struct BundleAdjustmentProblem {
   // Per point: held fixed (a loaded map's point in localisation only); empty: every point free.
   std::vector<uint8_t> point_fixed;
   std::vector<BaObservation> observations;
+  std::vector<BaPlaneDistance> plane_distances;  // not part of the recorded problem files
 };
 
 struct BundleAdjustmentResult {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -39,6 +40,16 @@ class KeyFrame {
   // Monocular core with a network: the network's error in this view against the triangulated
   // points (local mapping refits it after each local BA that moves the keyframe).
   InverseDepthAffine network_fit;
+  // The road under the camera as measured at this keyframe with a known camera height
+  // (depth.ground_in_ba): its normal in the camera's frame, the map points on it, and the
+  // height they lie below the camera, which local BA holds (a scale observation per keyframe).
+  struct Ground {
+    Eigen::Vector3d normal_cam = Eigen::Vector3d(0, -1, 0);
+    double height = 0.0;
+    double sigma = 1.0;               // per point, in the map's units
+    std::vector<uint64_t> point_ids;  // ascending
+  };
+  std::optional<Ground> ground;
 
   // Scratch of the tracker and local mapping.
   uint64_t local_map_frame = UINT64_MAX;

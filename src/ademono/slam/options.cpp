@@ -46,7 +46,10 @@ const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
                                      Range::AtLeast(3))
                                 .Add("ground_tolerance", &D::ground_tolerance, Range::AtLeast(0))
                                 .Add("ground_min_parallax_deg", &D::ground_min_parallax_deg,
-                                     Range::AtLeast(0));
+                                     Range::AtLeast(0))
+                                .Add("ground_in_ba", &D::ground_in_ba)
+                                .Add("ground_point_sigma", &D::ground_point_sigma,
+                                     Range::Above(0));
   return table;
 }
 

@@ -76,6 +76,11 @@ struct FrameDepthOptions {
   // Monocular core: a network-placed map point measures the ground only once two of its views
   // are this far apart (triangulated, not the network's reading of the road).
   double ground_min_parallax_deg = 1.0;
+  // Local BA holds each keyframe's road points at camera_height below it (residual sigma
+  // ground_point_sigma x camera_height per point, Huber): the known height observes the scale in
+  // every window, so scale drift is corrected where it happens, not only on average.
+  bool ground_in_ba = false;
+  double ground_point_sigma = 0.05;
   double ground_max_tilt_deg = 15.0;  // the ground's normal within this of the camera's up axis
   double ground_inlier_ratio = 0.05;  // inliers within this fraction of the height
   int ground_min_inliers = 50;

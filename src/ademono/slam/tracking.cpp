@@ -251,14 +251,25 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
+        std::optional<KeyFrame::Ground> ground;
         if (options_.depth.GroundScale() && !map_loaded_) {
-          if (const std::optional<double> height = MeasureGround(frame, true)) {
+          KeyFrame::Ground measured;
+          if (const std::optional<double> height = MeasureGround(frame, true, &measured)) {
             ground_heights_.push_back(*height);
             ground_height_frames_.push_back(index);
+            if (options_.depth.ground_in_ba &&
+                static_cast<int>(measured.point_ids.size()) >= options_.depth.ground_min_inliers)
+              ground = measured;
           }
         }
         AnchorScale(frame);
         out.new_keyframe = CreateNewKeyFrame(frame, &out.created_points);
+        if (ground) {
+          // The rig's height, in the map's units once AnchorScale made them metres.
+          ground->height = options_.depth.camera_height;
+          ground->sigma = options_.depth.ground_point_sigma * options_.depth.camera_height;
+          out.new_keyframe->ground = std::move(ground);
+        }
       }
       // Outliers do not carry over to the next frame's motion-model search.
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
@@ -417,13 +428,16 @@ void Tracking::AnchorScale(Frame& frame) {
   RescaleWorld(frame, std::exp(-mean));
 }
 
-std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_points) const {
+std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_points,
+                                              KeyFrame::Ground* ground) const {
   const FrameFeatures& f = frame.F();
   std::vector<Eigen::Vector3d> points;
-  auto add = [&](const Eigen::Vector3d& p) {
+  std::vector<uint64_t> ids;
+  auto add = [&](const Eigen::Vector3d& p, uint64_t id = 0) {
     if (p.y() > 0 && p.z() > 0 && p.z() <= options_.depth.ground_max_depth &&
         std::abs(p.x()) <= options_.depth.ground_max_lateral) {
       points.push_back(p);
+      ids.push_back(id);
     }
   };
   if (map_points) {
@@ -434,7 +448,7 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
       // A point the network placed counts only once other views have triangulated it: the
       // network's road rises ahead, and the first map is all network (KITTI: 12 m "heights").
       if (point->depth_prior && !Triangulated(*point)) continue;
-      add(*frame.cam_from_world * point->position);
+      add(*frame.cam_from_world * point->position, point->id);
     }
   } else {
     for (size_t i = 0; i < f.Size(); ++i) {
@@ -448,6 +462,16 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
   options.min_inliers = options_.depth.ground_min_inliers;
   const GroundPlane plane = EstimateGroundPlane(points, options);
   if (!plane.valid) return std::nullopt;
+  if (ground != nullptr && map_points) {
+    ground->normal_cam = plane.normal;
+    ground->point_ids.clear();
+    for (size_t k = 0; k < points.size(); ++k) {
+      if (std::abs(plane.normal.dot(points[k]) + plane.height) <=
+          options.inlier_ratio * plane.height)
+        ground->point_ids.push_back(ids[k]);
+    }
+    std::sort(ground->point_ids.begin(), ground->point_ids.end());
+  }
   return plane.height;
 }
 

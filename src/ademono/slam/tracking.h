@@ -172,7 +172,9 @@ class Tracking {
   // keypoints below the horizon, off dynamic boxes and in the corridor ahead: on the map points
   // they track (`map_points`, map units: the map's own scale, whatever biased it) or on their
   // own depths (the source's units, before any correction; for the first map).
-  std::optional<double> MeasureGround(const Frame& frame, bool map_points) const
+  // With `ground` (map points only), also the plane's normal and the ids of the points on it.
+  std::optional<double> MeasureGround(const Frame& frame, bool map_points,
+                                      KeyFrame::Ground* ground = nullptr) const
       ADEMONO_REQUIRES(map_.mutex);
   // Whether two of the point's views are at least depth.ground_min_parallax_deg apart.
   bool Triangulated(const MapPoint& point) const ADEMONO_REQUIRES(map_.mutex);
