@@ -207,6 +207,8 @@ def main():
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
             ]
+            if r == "kitti":
+                ablation.append((r, "no_ground_in_ba", ["--set", "depth.ground_in_ba=false"]))
     folders = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
         futures = {pool.submit(rows.one, r, m): (r, m) for r, m in jobs}
