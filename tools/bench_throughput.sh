@@ -9,6 +9,7 @@
 #                 same outputs as default, shows what the mapping thread buys)
 #   no-prefetch   --no-overlap (decode, extraction and depth on the tracking thread: same outputs
 #                 as default, shows what the prefetch thread buys)
+#   none          --depth none: the monocular core with no depth at all (network_indoor.yaml)
 #   network       FastDepth + YOLOX-nano, default schedule (issue 13 item 5); --no-network skips it
 # A second table gives the stage medians per thread, as summary.json's "timing" labels them
 # (prefetch: decode, depth, detection, ORB extraction and keypoint depths of frame k+1 while
@@ -44,11 +45,12 @@ run_case() {
   "$bin" run --overwrite "${common[@]}" "$@" "${extra[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 ||
     { echo "bench_throughput: case $name failed, see $out/$name.log" >&2; exit 1; }
 }
-cases=(default synchronous inline no-prefetch)
+cases=(default synchronous inline no-prefetch none)
 run_case default
 run_case synchronous --set mapping.handoff_frames=0
 run_case inline --set mapping.threaded=false
 run_case no-prefetch --no-overlap
+run_case none --depth none
 if [ "$network" = 1 ]; then
   run_case network \
     --depth "model:$models/fastdepth_nyu_320.onnx,spec=$here/configs/models/fastdepth_nyu.yaml" \
