@@ -120,6 +120,10 @@ TEST_F(DetectionIoTest, ErrorsNameFileAndLine) {
   EXPECT_EQ(
       ReadError(ok + "{\"frame\": 1, \"detections\": [\n").rfind(file + ":2: not valid JSON: ", 0),
       0u);
+  // A number beyond a double is nlohmann's out_of_range, not a parse_error (found by fuzzing).
+  EXPECT_EQ(ReadError("{\"frame\": 0, \"x\": [2016e7776], \"detections\": []}\n")
+                .rfind(file + ":1: not valid JSON: number overflow", 0),
+            0u);
   EXPECT_EQ(ReadError(ok + "[1, 2]\n"), file + ":2: expected a JSON object per line");
   EXPECT_EQ(ReadError("{\"detections\": []}\n"), file + ":1: missing \"frame\"");
   EXPECT_EQ(ReadError("{\"frame\": -1, \"detections\": []}\n"),

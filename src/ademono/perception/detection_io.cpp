@@ -85,7 +85,8 @@ FrameDetections ParseFrameLine(const std::string& text, const std::filesystem::p
   json object;
   try {
     object = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // A syntax error, or a number beyond a double (out_of_range.406, found by fuzzing).
     // nlohmann's message starts with "[json.exception.parse_error.101] "; keep what follows.
     std::string message = e.what();
     if (const auto pos = message.find("] "); pos != std::string::npos) message.erase(0, pos + 2);

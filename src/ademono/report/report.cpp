@@ -659,7 +659,7 @@ RunFolder ReadRunFolder(const fs::path& dir) {
   RequireFile(summary_path);
   try {
     run.summary = json::parse(ReadTextFile(summary_path));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, or a number beyond a double
     ThrowInputError(summary_path, std::string("not valid JSON: ") + e.what());
   }
   const json schema = RequireKey(run.summary, "schema", summary_path);
