@@ -4,7 +4,7 @@ with its network, through the shipped settings families (configs/network_indoor.
 network_outdoor.yaml, which `run` picks), nothing set per sequence.
 
   tools/geometry_acceptance.py [--bin B] [--shared DIR] [--out DIR] [--rows a,b,...] [--cache]
-                               [--ablation] [--jobs N] [--set KEY=VALUE]...
+                               [--ablation] [--jobs N] [--seed N] [--set KEY=VALUE]...
 
 Rows: seqa (7-Scenes seq-a, FastDepth), bonn (bonn-crowd-a, FastDepth + YOLOX-nano), kitti
 (KITTI 00 frames 0-199, PyDNet), office and street (synthetic, the simulated network). Each row
@@ -131,6 +131,8 @@ class Rows:
         cmd += self.config(row) + list(extra)
         for kv in self.a.set:
             cmd += ["--set", kv]
+        if self.a.seed is not None:
+            cmd += ["--seed", str(self.a.seed)]
         run(cmd, out + ".log")
         return out
 
@@ -178,6 +180,9 @@ def main():
     p.add_argument("--cache", action="store_true")
     p.add_argument("--ablation", action="store_true")
     p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--seed", type=int, default=None,
+                   help="the distant filter's seed for every run (default: the config's). On KITTI "
+                        "and the street a run is one draw: re-seeding moves sim3 by +-20 %%")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="passed to every run (to try a setting on every sequence at once)")
     a = p.parse_args()
@@ -209,6 +214,8 @@ def main():
             ]
             if r == "kitti":
                 ablation.append((r, "no_ground_in_ba", ["--set", "depth.ground_in_ba=false"]))
+                ablation.append((r, "held_ground_normal",
+                                 ["--set", "depth.ground_free_normal=false"]))
     folders = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
         futures = {pool.submit(rows.one, r, m): (r, m) for r, m in jobs}

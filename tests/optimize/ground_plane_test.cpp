@@ -56,6 +56,9 @@ TEST(GroundPlaneTest, WallsAndCarsAreNotTheGround) {
   ASSERT_TRUE(plane.valid);
   EXPECT_NEAR(plane.height, 1.65, 1e-9);
   EXPECT_EQ(plane.num_inliers, static_cast<int>(road));
+  // The inliers named are the road's points, the first `road` given, in order.
+  ASSERT_EQ(plane.inliers.size(), road);
+  for (size_t i = 0; i < road; ++i) EXPECT_EQ(plane.inliers[i], static_cast<int>(i));
 }
 
 TEST(GroundPlaneTest, AKerbAsPopulousAsTheRoadTiltsThePlane) {

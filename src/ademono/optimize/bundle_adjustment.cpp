@@ -2,8 +2,11 @@
 
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <stdexcept>
+
+#include <spdlog/spdlog.h>
 
 #include "ademono/core/options_table.h"
 #include "ademono/optimize/residuals.h"
@@ -47,10 +50,19 @@ struct PlaneDistanceResidual {
   explicit PlaneDistanceResidual(const BaPlaneDistance& d) : d(d) {}
   template <typename T>
   bool operator()(const T* camera, const T* point, T* residual) const {
+    const T normal[3] = {T(d.normal_cam[0]), T(d.normal_cam[1]), T(d.normal_cam[2])};
+    return Along(camera, point, normal, residual);
+  }
+  template <typename T>
+  bool operator()(const T* camera, const T* point, const T* normal, T* residual) const {
+    return Along(camera, point, normal, residual);
+  }
+  template <typename T>
+  bool Along(const T* camera, const T* point, const T* normal, T* residual) const {
     T q[3];
     ceres::AngleAxisRotatePoint(camera, point, q);
     T along = T(0);
-    for (int k = 0; k < 3; ++k) along += T(d.normal_cam[k]) * (q[k] + camera[3 + k]);
+    for (int k = 0; k < 3; ++k) along += normal[k] * (q[k] + camera[3 + k]);
     residual[0] = T(d.inv_sigma) * (along - T(d.distance));
     return true;
   }
@@ -60,7 +72,8 @@ struct PlaneDistanceResidual {
 // Solves with the observations not flagged in `skip`; returns whether Ceres converged.
 bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
            const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
-           std::vector<double>& points) {
+           std::vector<double>& points, std::vector<double>& normals,
+           const std::vector<size_t>& normal_slot) {
   ceres::Problem ceres_problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<bool> point_used(problem.points.size(), false),
@@ -82,12 +95,25 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
   }
   if (ceres_problem.NumResidualBlocks() == 0) return false;
   // Only on points and cameras the observations keep: the plane never holds an outlier's point.
-  for (const BaPlaneDistance& d : problem.plane_distances) {
+  for (size_t i = 0; i < problem.plane_distances.size(); ++i) {
+    const BaPlaneDistance& d = problem.plane_distances[i];
     if (!point_used[d.point] || !camera_used[d.camera]) continue;
+    if (d.plane < 0) {
+      ceres_problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<PlaneDistanceResidual, 1, 6, 3>(
+              new PlaneDistanceResidual(d)),
+          new ceres::HuberLoss(1.0), &cameras[6 * d.camera], &points[3 * d.point]);
+      continue;
+    }
+    double* normal = &normals[3 * normal_slot[i]];
     ceres_problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<PlaneDistanceResidual, 1, 6, 3>(
+        new ceres::AutoDiffCostFunction<PlaneDistanceResidual, 1, 6, 3, 3>(
             new PlaneDistanceResidual(d)),
-        new ceres::HuberLoss(1.0), &cameras[6 * d.camera], &points[3 * d.point]);
+        new ceres::HuberLoss(1.0), &cameras[6 * d.camera], &points[3 * d.point], normal);
+    if (!ceres_problem.HasManifold(normal)) {
+      ceres_problem.SetManifold(normal, new ceres::SphereManifold<3>());
+      ordering->AddElementToGroup(normal, 1);
+    }
   }
   for (size_t c = 0; c < problem.cameras.size(); ++c) {
     if (!camera_used[c]) continue;
@@ -121,6 +147,11 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
   options.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &ceres_problem, &summary);
+  spdlog::debug("BA solve: {} iterations, {} residuals, {:.1f} ms (linear {:.1f}, eval {:.1f}), {}",
+                summary.iterations.size(), summary.num_residual_blocks,
+                1e3 * summary.total_time_in_seconds, 1e3 * summary.linear_solver_time_in_seconds,
+                1e3 * (summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds),
+                summary.message);
   return summary.termination_type == ceres::CONVERGENCE ||
          summary.termination_type == ceres::NO_CONVERGENCE;
 }
@@ -167,14 +198,28 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
     for (int k = 0; k < 3; ++k) points[3 * p + k] = problem.points[p][k];
   }
 
+  // One normal per (camera, plane), kept in the slot of its first distance.
+  std::vector<double> normals(3 * problem.plane_distances.size());
+  std::vector<size_t> normal_slot(problem.plane_distances.size());
+  std::map<std::pair<size_t, int>, size_t> slot_of;
+  for (size_t i = 0; i < problem.plane_distances.size(); ++i) {
+    const BaPlaneDistance& d = problem.plane_distances[i];
+    if (d.plane < 0) continue;
+    const auto [it, inserted] = slot_of.emplace(std::make_pair(d.camera, d.plane), i);
+    normal_slot[i] = it->second;
+    if (inserted) {
+      for (int k = 0; k < 3; ++k) normals[3 * i + k] = d.normal_cam.normalized()[k];
+    }
+  }
+
   BundleAdjustmentResult result;
   result.outlier.assign(problem.observations.size(), false);
-  result.converged =
-      Solve(problem, options, result.outlier, options.first_iterations, cameras, points);
+  result.converged = Solve(problem, options, result.outlier, options.first_iterations, cameras,
+                           points, normals, normal_slot);
   ClassifyOutliers(problem, cameras, points, result.outlier);
   if (options.second_iterations > 0) {
-    result.converged =
-        Solve(problem, options, result.outlier, options.second_iterations, cameras, points);
+    result.converged = Solve(problem, options, result.outlier, options.second_iterations, cameras,
+                             points, normals, normal_slot);
     ClassifyOutliers(problem, cameras, points, result.outlier);
   }
 

@@ -58,6 +58,10 @@ struct BaPlaneDistance {
   // normal pointing from the road to the camera)
   double distance = 0.0;
   double inv_sigma = 1.0;
+  // Distances of one camera with the same `plane` >= 0 share one normal, solved for on the unit
+  // sphere from `normal_cam` (the first of them): the points decide the plane's tilt, the known
+  // distance only the scale. -1: the normal is held as given.
+  int plane = -1;
 };
 
 struct BundleAdjustmentProblem {

@@ -123,7 +123,12 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
     return result;
   }
   best = refit;
-  const int count = CountInliers(best, points_cam, options.inlier_ratio * best.height);
+  std::vector<int> inliers;
+  for (size_t i = 0; i < n; ++i) {
+    if (std::abs(Distance(best, points_cam[i])) <= options.inlier_ratio * best.height)
+      inliers.push_back(static_cast<int>(i));
+  }
+  const int count = static_cast<int>(inliers.size());
   if (count < options.min_inliers || count < options.min_inlier_share * static_cast<double>(n)) {
     return result;
   }
@@ -131,6 +136,7 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
   result.normal = best.normal;
   result.height = best.height;
   result.num_inliers = count;
+  result.inliers = std::move(inliers);
   result.num_points = static_cast<int>(n);
   result.inlier_share = static_cast<double>(count) / static_cast<double>(n);
   // Spread of the last refit's residuals, and the height's standard error at that spread:

@@ -38,6 +38,7 @@ struct GroundPlane {
   double height = 0.0;            // camera's distance above the plane, in the points' units
   int num_inliers = 0;
   int num_points = 0;             // points given (the candidates)
+  std::vector<int> inliers;       // indices into the points given of those on the plane
   // How much to trust it (valid estimates only): the share of the candidates on the plane, the
   // robust spread (1.4826 MAD) of the inliers' log-depth residuals, the height's standard error
   // relative to the height from the refit's covariance at that spread (an optimistic bound:

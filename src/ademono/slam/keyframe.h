@@ -47,6 +47,7 @@ class KeyFrame {
     Eigen::Vector3d normal_cam = Eigen::Vector3d(0, -1, 0);
     double height = 0.0;
     double sigma = 1.0;               // per point, in the map's units
+    bool free_normal = false;         // local BA solves for the normal (depth.ground_free_normal)
     std::vector<uint64_t> point_ids;  // ascending
   };
   std::optional<Ground> ground;

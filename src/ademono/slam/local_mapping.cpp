@@ -412,10 +412,13 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     // The first keyframe alone fixed leaves the gauge free when nothing else is fixed; ORB-SLAM
     // accepts that, but a fixed frame keeps repeated runs anchored.
     problem.intrinsics = keyframe.F().intrinsics;
+    // Point ids to problem indices, only for the road residuals below (depth.ground_in_ba).
+    const bool any_ground =
+        std::any_of(cameras.begin(), cameras.end(), [](const auto& kf) { return kf && kf->ground; });
     std::map<uint64_t, size_t> point_index_of;
     for (MapPoint* p : local_points) {
       const size_t point_index = problem.points.size();
-      point_index_of[p->id] = point_index;
+      if (any_ground) point_index_of[p->id] = point_index;
       problem.points.push_back(p->position);
       problem.point_fixed.push_back(p->frozen ? 1 : 0);
       points.push_back(map_.GetMapPoint(p->id));
@@ -432,14 +435,15 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       }
     }
     // Each keyframe's road points at the rig's height below it (depth.ground_in_ba).
-    for (size_t c = 0; c < cameras.size(); ++c) {  // in camera order: a deterministic problem
+    for (size_t c = 0; any_ground && c < cameras.size(); ++c) {  // in camera order: deterministic
       const KeyFrame& kf = *cameras[c];
       if (!kf.ground) continue;
       for (uint64_t id : kf.ground->point_ids) {
         const auto it = point_index_of.find(id);
         if (it == point_index_of.end()) continue;
         problem.plane_distances.push_back({c, it->second, kf.ground->normal_cam,
-                                           -kf.ground->height, 1.0 / kf.ground->sigma});
+                                           -kf.ground->height, 1.0 / kf.ground->sigma,
+                                           kf.ground->free_normal ? 0 : -1});
       }
     }
   }

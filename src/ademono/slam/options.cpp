@@ -49,7 +49,8 @@ const OptionsTable<FrameDepthOptions>& FrameDepthOptions::Table() {
                                      Range::AtLeast(0))
                                 .Add("ground_in_ba", &D::ground_in_ba)
                                 .Add("ground_point_sigma", &D::ground_point_sigma,
-                                     Range::Above(0));
+                                     Range::Above(0))
+                                .Add("ground_free_normal", &D::ground_free_normal);
   return table;
 }
 

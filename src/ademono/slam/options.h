@@ -81,6 +81,10 @@ struct FrameDepthOptions {
   // every window, so scale drift is corrected where it happens, not only on average.
   bool ground_in_ba = false;
   double ground_point_sigma = 0.05;
+  // With ground_in_ba: local BA solves for each keyframe's road normal from its road points
+  // (on the unit sphere) instead of holding the one measured at the keyframe, so the known
+  // height observes only the scale and a misread tilt does not bend the map.
+  bool ground_free_normal = false;
   double ground_max_tilt_deg = 15.0;  // the ground's normal within this of the camera's up axis
   double ground_inlier_ratio = 0.05;  // inliers within this fraction of the height
   int ground_min_inliers = 50;

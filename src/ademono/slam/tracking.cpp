@@ -268,6 +268,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
           // The rig's height, in the map's units once AnchorScale made them metres.
           ground->height = options_.depth.camera_height;
           ground->sigma = options_.depth.ground_point_sigma * options_.depth.camera_height;
+          ground->free_normal = options_.depth.ground_free_normal;
           out.new_keyframe->ground = std::move(ground);
         }
       }
@@ -465,11 +466,7 @@ std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_point
   if (ground != nullptr && map_points) {
     ground->normal_cam = plane.normal;
     ground->point_ids.clear();
-    for (size_t k = 0; k < points.size(); ++k) {
-      if (std::abs(plane.normal.dot(points[k]) + plane.height) <=
-          options.inlier_ratio * plane.height)
-        ground->point_ids.push_back(ids[k]);
-    }
+    for (int k : plane.inliers) ground->point_ids.push_back(ids[static_cast<size_t>(k)]);
     std::sort(ground->point_ids.begin(), ground->point_ids.end());
   }
   return plane.height;
