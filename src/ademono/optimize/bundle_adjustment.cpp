@@ -150,7 +150,8 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
   spdlog::debug("BA solve: {} iterations, {} residuals, {:.1f} ms (linear {:.1f}, eval {:.1f}), {}",
                 summary.iterations.size(), summary.num_residual_blocks,
                 1e3 * summary.total_time_in_seconds, 1e3 * summary.linear_solver_time_in_seconds,
-                1e3 * (summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds),
+                1e3 * (summary.residual_evaluation_time_in_seconds +
+                       summary.jacobian_evaluation_time_in_seconds),
                 summary.message);
   return summary.termination_type == ceres::CONVERGENCE ||
          summary.termination_type == ceres::NO_CONVERGENCE;
@@ -198,17 +199,19 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
     for (int k = 0; k < 3; ++k) points[3 * p + k] = problem.points[p][k];
   }
 
-  // One normal per (camera, plane), kept in the slot of its first distance.
-  std::vector<double> normals(3 * problem.plane_distances.size());
+  // One solved normal per (camera, plane), started from its first distance's; normal_slot[i] is
+  // distance i's (unused for held normals).
+  std::vector<double> normals;
   std::vector<size_t> normal_slot(problem.plane_distances.size());
   std::map<std::pair<size_t, int>, size_t> slot_of;
   for (size_t i = 0; i < problem.plane_distances.size(); ++i) {
     const BaPlaneDistance& d = problem.plane_distances[i];
     if (d.plane < 0) continue;
-    const auto [it, inserted] = slot_of.emplace(std::make_pair(d.camera, d.plane), i);
+    const auto [it, inserted] = slot_of.emplace(std::make_pair(d.camera, d.plane), slot_of.size());
     normal_slot[i] = it->second;
     if (inserted) {
-      for (int k = 0; k < 3; ++k) normals[3 * i + k] = d.normal_cam.normalized()[k];
+      const Eigen::Vector3d unit = d.normal_cam.normalized();
+      normals.insert(normals.end(), unit.data(), unit.data() + 3);
     }
   }
 

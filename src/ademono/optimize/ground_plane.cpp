@@ -40,10 +40,24 @@ bool Orient(Eigen::Vector3d normal, double offset, Plane* plane) {
   return true;
 }
 
+bool OnPlane(const Plane& plane, const Eigen::Vector3d& p, double tolerance) {
+  return std::abs(Distance(plane, p)) <= tolerance;
+}
+
+// RANSAC's score: counts without collecting (the final fit collects, InlierIndices).
 int CountInliers(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double tolerance) {
   int n = 0;
-  for (const Eigen::Vector3d& p : points) n += std::abs(Distance(plane, p)) <= tolerance ? 1 : 0;
+  for (const Eigen::Vector3d& p : points) n += OnPlane(plane, p, tolerance) ? 1 : 0;
   return n;
+}
+
+std::vector<int> InlierIndices(const Plane& plane, const std::vector<Eigen::Vector3d>& points,
+                               double tolerance) {
+  std::vector<int> inliers;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (OnPlane(plane, points[i], tolerance)) inliers.push_back(static_cast<int>(i));
+  }
+  return inliers;
 }
 
 }  // namespace
@@ -123,11 +137,7 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
     return result;
   }
   best = refit;
-  std::vector<int> inliers;
-  for (size_t i = 0; i < n; ++i) {
-    if (std::abs(Distance(best, points_cam[i])) <= options.inlier_ratio * best.height)
-      inliers.push_back(static_cast<int>(i));
-  }
+  std::vector<int> inliers = InlierIndices(best, points_cam, options.inlier_ratio * best.height);
   const int count = static_cast<int>(inliers.size());
   if (count < options.min_inliers || count < options.min_inlier_share * static_cast<double>(n)) {
     return result;
