@@ -27,7 +27,8 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
   app.add_option("--frames", args.frames, "START:END frame range (END exclusive)");
   app.add_option(
       "--seed", args.seed,
-      "random seed of the distant filter: N or 'time' (default: the config's filter.seed)");
+      "random seed of the distant filter and the two-view initialiser's RANSAC: N or 'time' "
+      "(default: the config's filter.seed and initializer.seed)");
   app.add_flag("--no-overlap", args.no_overlap,
                "compute depth/detections sequentially (no prefetch)");
   app.add_option("--prefetch-frames", args.prefetch_frames,

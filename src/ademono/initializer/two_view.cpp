@@ -24,7 +24,8 @@ const OptionsTable<TwoViewOptions>& TwoViewOptions::Table() {
           .Add("min_parallax_deg", &T::min_parallax_deg, Range::AtLeast(0))
           .Add("min_triangulated", &T::min_triangulated, Range::AtLeast(8))
           .Add("min_triangulated_ratio", &T::min_triangulated_ratio, Range::Closed(0, 1))
-          .Add("max_direction_sigma_deg", &T::max_direction_sigma_deg, Range::Above(0));
+          .Add("max_direction_sigma_deg", &T::max_direction_sigma_deg, Range::Above(0))
+          .Add("seed", &T::seed);
   return table;
 }
 

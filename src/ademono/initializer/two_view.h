@@ -23,7 +23,7 @@ template <typename Options>
 class OptionsTable;
 
 struct TwoViewOptions {
-  int ransac_iterations = 200;
+  int ransac_iterations = 1000;  // ORB-SLAM's 200 fails for some draws (configs/network_indoor.yaml)
   double sigma_px = 1.0;  // keypoint position sigma at level 0 (chi2 thresholds scale with it)
   // R_H above this: the homography (ORB-SLAM2: 0.40).
   double homography_ratio = 0.40;
@@ -36,6 +36,8 @@ struct TwoViewOptions {
   // ORB-SLAM's parallax test, which low-parallax views with a narrow field pass with a wrong
   // motion (7-Scenes seq-a frames 0-20: 1 deg of parallax, sigma 6 deg, the direction 108 deg off).
   double max_direction_sigma_deg = 2.0;
+  // RANSAC's minimal sets (`run --seed` sets it with filter.seed): without depth it is the only
+  // draw in a run, so it is what re-draws a geometric-only run.
   uint64_t seed = 0;
   void Check() const;  // throws std::invalid_argument
   static const OptionsTable<TwoViewOptions>& Table();
