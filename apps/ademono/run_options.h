@@ -24,7 +24,7 @@ struct SequenceRunArgs {
   std::string depth = "sensor";
   std::string detector = "none";
   std::string frames;
-  std::string seed;  // empty: the config's filter.seed
+  std::string seed;  // empty: the config's filter.seed and initializer.seed
   bool no_overlap = false;
   int prefetch_frames = 0;  // 0: 2 with a depth network (model:), else 1
   std::string viz;

@@ -55,7 +55,8 @@ struct Plan {
   std::filesystem::path root;
   std::vector<PlanDataset> datasets;
   std::vector<PlanVariant> variants;
-  std::vector<std::optional<uint64_t>> seeds;  // nullopt: the config's filter.seed
+  // nullopt: the config's filter.seed and initializer.seed (--seed sets both)
+  std::vector<std::optional<uint64_t>> seeds;
   SlurmSettings slurm;
   int jobs = 0;  // local engine pool size, 0: the CPU count
 };
