@@ -232,7 +232,7 @@ class PySystem {
     camera.Check();
     const auto [node, path] = ConfigNode(config);
     SystemOptions options = SystemOptions::FromYaml(node, path);
-    if (seed) options.filter.seed = options.initializer.seed = *seed;
+    if (seed) options.SetSeed(*seed);
     camera_ = camera;
     system_ = std::make_unique<System>(camera, options);
     if (live) {

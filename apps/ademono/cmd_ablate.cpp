@@ -69,8 +69,7 @@ int Ablate(const AblateArgs& args) {
   options.config = config_path.string();
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
   options.detector = detector_options;
-  if (!args.seed.empty())
-    options.system.filter.seed = options.system.initializer.seed = ParseSeed(args.seed);
+  if (!args.seed.empty()) options.system.SetSeed(ParseSeed(args.seed));
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &options.pipeline.start, &options.pipeline.end);
   options.pipeline.overlap = !args.no_overlap;

@@ -163,7 +163,7 @@ int Run(const RunArgs& args) {
   ApplyDepthSource(args.depth, options);
   ApplyDatasetCameraHeight(config, *sequence, options);
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);
-  if (!args.seed.empty()) options.filter.seed = options.initializer.seed = ParseSeed(args.seed);
+  if (!args.seed.empty()) options.SetSeed(ParseSeed(args.seed));
   if (args.no_enhancement) options.filter.enable_enhancement = false;
   if (args.no_dynamic_removal) options.filter.enable_dynamic_removal = false;
   if (args.no_distant_filter) options.filter.enable_distant_filter = false;

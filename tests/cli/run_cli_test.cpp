@@ -146,7 +146,14 @@ TEST_F(RunCliTest, SeedRedrawsAGeometricRunAndEveryDrawInitialises) {
     EXPECT_LT(summary["accuracy"]["ate_sim3_rmse_m"].get<double>(), 0.03) << run;
   }
   // The resolved options saved with the run say which draw it was.
-  EXPECT_NE(ReadFile(out_ / "a" / "config.resolved.yaml").find("  seed: 1\n"), std::string::npos);
+  // The initializer: section (up to the next top-level key) holds it, not only the filter's.
+  const std::string resolved = ReadFile(out_ / "a" / "config.resolved.yaml");
+  const size_t start = resolved.find("\ninitializer:\n");
+  ASSERT_NE(start, std::string::npos);
+  size_t end = start + 1;
+  do end = resolved.find('\n', end + 1);
+  while (end != std::string::npos && end + 1 < resolved.size() && resolved[end + 1] == ' ');
+  EXPECT_NE(resolved.substr(start, end - start + 1).find("\n  seed: 1\n"), std::string::npos);
 }
 
 TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {

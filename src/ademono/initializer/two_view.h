@@ -23,7 +23,8 @@ template <typename Options>
 class OptionsTable;
 
 struct TwoViewOptions {
-  int ransac_iterations = 1000;  // ORB-SLAM's 200 fails for some draws (configs/network_indoor.yaml)
+  // ORB-SLAM's 200 left seq-a uninitialised on some draws (configs/network_indoor.yaml).
+  int ransac_iterations = 1000;
   double sigma_px = 1.0;  // keypoint position sigma at level 0 (chi2 thresholds scale with it)
   // R_H above this: the homography (ORB-SLAM2: 0.40).
   double homography_ratio = 0.40;

@@ -205,6 +205,8 @@ const OptionsTable<SystemOptions>& SystemOptions::Table() {
   return table;
 }
 
+void SystemOptions::SetSeed(uint64_t seed) { filter.seed = initializer.seed = seed; }
+
 void SystemOptions::Check() const {
   orb.Check();
   filter.Check();

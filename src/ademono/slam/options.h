@@ -268,6 +268,9 @@ struct SystemOptions {
   KeyFrameDatabaseOptions place;  // place recognition index (relocalisation, loops)
   LoopOptions loop;
   TwoViewOptions initializer;  // the monocular two-view initialisation
+  // A run's one seed (`--seed`, Python `seed=`): every random draw's, the distant filter's and the
+  // two-view initialiser's RANSAC's.
+  void SetSeed(uint64_t seed);
   void Check() const;
   // Reads every sub-node of a config file's root. InputError "path: ..." on any problem, also for
   // an unknown key in `detector:` (DetectorOptions, read by the caller) and an unknown section.
