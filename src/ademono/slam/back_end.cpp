@@ -185,7 +185,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   if (out.new_keyframe) {
     result.new_keyframe = true;
-    local_mapping_.InsertKeyFrame(out.new_keyframe, frame.index);
+    local_mapping_.InsertKeyFrame(out.new_keyframe, frames_);  // the hand-off clock, not the dataset index
     // Inserting merges the previous keyframe: a loop closed there moved the world under this frame.
     MutexLock lock(map_.mutex);
     tracking_.AssertMapHeld();
