@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "cli_test_util.h"
@@ -28,7 +29,7 @@ std::string Bytes(const fs::path& path) {
 class MapCliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(fs::temp_directory_path() / ("ademono_map_cli_" + std::to_string(::getpid())));
+    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() / ("ademono_map_cli_" + std::to_string(::getpid())));
     fs::remove_all(*dir_);
     fs::create_directories(*dir_);
     const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
@@ -38,12 +39,11 @@ class MapCliTest : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
-    delete dir_;
+    dir_.reset();
   }
   static fs::path MapPath() { return *dir_ / "seq-a-0-60.map"; }
-  static fs::path* dir_;
+  static inline std::unique_ptr<fs::path> dir_;
 };
-fs::path* MapCliTest::dir_ = nullptr;
 
 TEST_F(MapCliTest, LocalizeOnlyTracksEveryFrameWithinTheBoundAndLeavesTheFile) {
   ASSERT_TRUE(fs::exists(MapPath()));

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "ademono/core/statistics.h"
@@ -39,7 +40,7 @@ class GroundPlaneKittiTest : public testing::Test {
     tracking.min_depth = 0;
     tracking.max_depth = 25;
     tracking.max_lateral = 4;
-    fits_ = new std::vector<FrameFit>();
+    fits_ = std::make_unique<std::vector<FrameFit>>();
     for (size_t i = 0; i + 2 < sequence->Size(); i += 10) {
       const FrameData a = sequence->Load(i);
       const FrameData b = sequence->Load(i + 2);
@@ -54,8 +55,7 @@ class GroundPlaneKittiTest : public testing::Test {
     }
   }
   static void TearDownTestSuite() {
-    delete fits_;
-    fits_ = nullptr;
+    fits_.reset();
   }
   // The valid estimates' heights (or every one that has a height: `any`).
   static std::vector<double> Heights(GroundPlane FrameFit::*which, bool any = false) {
@@ -72,9 +72,8 @@ class GroundPlaneKittiTest : public testing::Test {
     });
     return static_cast<double>(n) / static_cast<double>(fits_->size());
   }
-  static std::vector<FrameFit>* fits_;
+  static inline std::unique_ptr<std::vector<FrameFit>> fits_;
 };
-std::vector<FrameFit>* GroundPlaneKittiTest::fits_ = nullptr;
 
 TEST_F(GroundPlaneKittiTest, APlaneThroughPyDNetsDepthTiltsUpAndReadsTheCameraTooHigh) {
   // Why depth.camera_height made KITTI worse: PyDNet reads the road 1.04x short at 5-10 m but

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <fstream>
 #include <sstream>
 
@@ -50,7 +51,7 @@ class MapIoTest : public ::testing::Test {
  protected:
   // One map of 7-Scenes frames 0-59, built once for the whole suite.
   static void SetUpTestSuite() {
-    dir_ = new fs::path(fs::temp_directory_path() / ("ademono_map_io_" + std::to_string(::getpid())));
+    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() / ("ademono_map_io_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
     const auto sequence = Slice(0, 60);
     System system(sequence->GetCamera(), TestOptions());
@@ -61,13 +62,12 @@ class MapIoTest : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
-    delete dir_;
+    dir_.reset();
   }
   static fs::path MapPath() { return *dir_ / "a.map"; }
-  static fs::path* dir_;
+  static inline std::unique_ptr<fs::path> dir_;
   static size_t keyframes_, points_;
 };
-fs::path* MapIoTest::dir_ = nullptr;
 size_t MapIoTest::keyframes_ = 0, MapIoTest::points_ = 0;
 
 // The ground truth of frame i in the first session's world (its first camera).
