@@ -8,8 +8,9 @@ network_outdoor.yaml, which `run` picks), nothing set per sequence.
 
 Rows: seqa (7-Scenes seq-a, FastDepth), bonn (bonn-crowd-a, FastDepth + YOLOX-nano), kitti
 (KITTI 00 frames 0-199, PyDNet), office and street (synthetic, the simulated network), and two
-held-out windows that start mid-sequence with the same criteria: seqa_late (seq-a frames 300-599)
-and kitti_late (KITTI 00 frames 100-199), `run --frames A:B` as a user would. Each row
+held-out windows that start mid-sequence with the same criteria: seqa_late (seq-a frames 300-599),
+bonn_late (bonn-crowd-a frames 232-463, a start inside the crowd) and kitti_late (KITTI 00 frames
+100-199), `run --frames A:B` as a user would. Each row
 runs twice, `none` and the network; the network row's sim3 is also scored on the frames the none
 run tracked (the "<= 1.1x none" criterion) with `ademono eval`. --cache replays `ademono infer`
 caches (made once under OUT/cache) instead of running the networks: faster, the same settings
@@ -43,7 +44,8 @@ CRITERIA = {
 # A run that starts mid-recording starts from no map, on frames the settings were not read from
 # in that order; it also exercised a bug the full runs could not (a keyframe's hand-off frame taken
 # from the dataset index: KITTI frames 100-199 with PyDNet made 4 keyframes, sim3 11 m).
-WINDOWS = {"seqa_late": ("seqa", "300:600"), "kitti_late": ("kitti", "100:200")}
+WINDOWS = {"seqa_late": ("seqa", "300:600"), "bonn_late": ("bonn", "232:464"),
+           "kitti_late": ("kitti", "100:200")}
 
 
 def base(row):
@@ -196,7 +198,8 @@ def main():
     p.add_argument("--bin", default=os.path.join(HERE, "build", "release", "bin", "ademono"))
     p.add_argument("--shared", default=os.path.join(HERE, "..", "shared"))
     p.add_argument("--out", default="/tmp/ademono_geometry_acceptance")
-    p.add_argument("--rows", default="seqa,bonn,kitti,office,street,seqa_late,kitti_late")
+    p.add_argument("--rows",
+                   default="seqa,bonn,kitti,office,street,seqa_late,bonn_late,kitti_late")
     p.add_argument("--cache", action="store_true")
     p.add_argument("--ablation", action="store_true")
     p.add_argument("--jobs", type=int, default=2)
