@@ -109,7 +109,7 @@ void BackEnd::SaveMap(const std::filesystem::path& path) {
   SaveMapFile(path, data);
 }
 
-void BackEnd::HandOff() { local_mapping_.HandOff(frames_); }
+void BackEnd::HandOff() { local_mapping_.HandOff(); }
 
 std::optional<Rigid3d> BackEnd::PredictNext() const {
   MutexLock lock(map_.mutex);
@@ -185,7 +185,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   result.tracking_ms = MsSince(start);
   if (out.new_keyframe) {
     result.new_keyframe = true;
-    local_mapping_.InsertKeyFrame(out.new_keyframe, frames_);  // the hand-off clock, not the dataset index
+    local_mapping_.InsertKeyFrame(out.new_keyframe);
     // Inserting merges the previous keyframe: a loop closed there moved the world under this frame.
     MutexLock lock(map_.mutex);
     tracking_.AssertMapHeld();
@@ -193,7 +193,6 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
     const auto& last = tracking_.LastFrame();
     if (out.tracked && last && last->cam_from_world) out.cam_from_world = *last->cam_from_world;
   }
-  ++frames_;
   // The keyframes merged by this frame (at their hand-off), each once.
   result.mapping_ms = local_mapping_.TakeFinishedMilliseconds();
   return result;

@@ -48,7 +48,8 @@ class BackEnd {
 
   // Start of a frame's back end, before PredictNext and Track: merges local mapping's pending
   // keyframe when this frame is its hand-off frame (the fixed schedule, slam/local_mapping.h).
-  // Frames are counted here (calls to Track), not by their input index, which may repeat or jump.
+  // Local mapping counts the frames (these calls), not their input index, which may repeat or
+  // jump.
   void HandOff();
   // Constant-velocity prediction of the next frame's pose (the dynamic filter's stage 2).
   std::optional<Rigid3d> PredictNext() const;
@@ -106,7 +107,6 @@ class BackEnd {
   Tracking tracking_;
   // Colour of each map point's first observation (for map.ply), keyed by point id.
   std::map<uint64_t, cv::Vec3b> point_colors_;
-  size_t frames_ = 0;  // Track calls so far: the hand-off schedule's clock
   // Localisation only: the map as loaded, what SaveMap writes (temporary keyframes never are).
   std::optional<MapFileData> loaded_map_;
   bool shut_down_ = false;

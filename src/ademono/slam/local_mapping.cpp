@@ -57,17 +57,18 @@ double LocalMapping::TakeFinishedMilliseconds() {
   return ms;
 }
 
-void LocalMapping::HandOff(size_t frame_index) {
-  if (pending_ && frame_index >= pending_->handoff_frame) Merge();
+void LocalMapping::HandOff() {
+  ++frames_;
+  if (pending_ && frames_ >= pending_->handoff_frame) Merge();
 }
 
-void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, size_t frame_index) {
+void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe) {
   if (pending_) Merge();  // one keyframe in flight: the next one maps on the merged map
   const auto start = std::chrono::steady_clock::now();
   const double start_cpu = ThreadCpuMs();
   auto pending = std::make_unique<Pending>();
   pending->keyframe = keyframe;
-  pending->handoff_frame = frame_index + static_cast<size_t>(options_.handoff_frames);
+  pending->handoff_frame = frames_ + static_cast<size_t>(options_.handoff_frames);
   {
     MutexLock lock(map_.mutex);
     ProcessNewKeyFrame(*keyframe);

@@ -8,7 +8,8 @@
 // on the tracking thread and the local BA problem is gathered there; the BA is then solved on the
 // mapping thread from that snapshot, while tracking goes on against the unchanged map, and its
 // result is merged (poses, points, outliers, then keyframe culling) under the map lock exactly
-// when frame f + mapping.handoff_frames starts, or earlier when the next keyframe comes. Tracking
+// when the mapping.handoff_frames-th frame after f starts (frames counted by HandOff calls, not by
+// their numbers), or earlier when the next keyframe comes. Tracking
 // never sees a half-applied BA and every decision depends only on the data, never on whether the
 // mapper happens to be idle: outputs are identical run to run, under any load, and with
 // mapping.threaded false (the solve runs on the tracking thread instead). handoff_frames 0 is the
@@ -46,13 +47,15 @@ class LocalMapping {
   // first keyframe.
   void SetLoopClosing(LoopClosing* loop_closing) { loop_closing_ = loop_closing; }
 
-  // Tracking thread, map.mutex not held. Merges the pending keyframe's BA when `frame_index` has
-  // reached its hand-off frame (waits for the mapping thread if it is not done).
-  void HandOff(size_t frame_index);
-  // Tracking thread, map.mutex not held: keyframe made at `frame_index`. Merges a pending
+  // Tracking thread, map.mutex not held, once at the start of every frame: advances the hand-off
+  // clock and merges the pending keyframe's BA when this frame is its hand-off frame (waits for
+  // the mapping thread if it is not done). The clock counts these calls, not the frames' numbers
+  // (a run may start at frame 300; a camera's counter jumps).
+  void HandOff();
+  // Tracking thread, map.mutex not held: a keyframe made at the current frame. Merges a pending
   // keyframe first, maps this one's structure and starts its BA.
-  void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe, size_t frame_index);
-  // True when no keyframe waits for its hand-off. A function of the frame indices alone (never
+  void InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe);
+  // True when no keyframe waits for its hand-off. A function of the frame count alone (never
   // of the mapping thread's progress), so tracking may decide on it deterministically.
   bool Idle() const;
   size_t QueueSize() const { return Idle() ? 0 : 1; }
@@ -76,7 +79,7 @@ class LocalMapping {
   // A keyframe between its insertion and its hand-off.
   struct Pending {
     std::shared_ptr<KeyFrame> keyframe;
-    size_t handoff_frame = 0;
+    size_t handoff_frame = 0;  // on the HandOff clock
     bool has_ba = false;
     BundleAdjustmentProblem problem;
     std::vector<std::shared_ptr<KeyFrame>> cameras;
@@ -120,6 +123,7 @@ class LocalMapping {
   bool job_done_ = false;   // guarded by job_mutex_
   bool stop_ = false;       // guarded by job_mutex_
   double finished_ms_ = 0;  // tracking thread only
+  size_t frames_ = 0;       // HandOff calls so far, the current frame's included: the clock
   bool shut_down_ = false;
   std::thread worker_;
 };
