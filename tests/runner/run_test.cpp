@@ -143,7 +143,8 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
   // A short xyz sequence revisits no place away from the live map: no loop.
   EXPECT_TRUE(s["loops"].is_array());
   EXPECT_TRUE(s["loops"].empty());
-  EXPECT_EQ(Keys(s["weak_poses"]), (std::set<std::string>{"few_static_points", "motion_model"}));
+  EXPECT_EQ(Keys(s["weak_poses"]),
+            (std::set<std::string>{"few_static_points", "motion_model", "depth_odometry"}));
   EXPECT_EQ(Keys(s["geometric_test"]),
             (std::set<std::string>{"enabled", "matches_judged_dynamic", "map_points_culled"}));
   EXPECT_EQ(Keys(s["filters"]),

@@ -227,7 +227,7 @@ json FramesJson(const RunFolder& run, double t0) {
   // Optional (runs before the geometric test lack them): -1 = not recorded, left out of the plot.
   const std::vector<std::string> optional_ints = {"static_points", "geometric_dynamic"};
   for (const auto& k : optional_ints) cols[k] = json::array();
-  cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model
+  cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model, 3 depth odometry
   json filter = json::object(), ms = json::object(), depth_scale = json::array();
   bool any_scale = false;
   size_t i = 0;
@@ -247,7 +247,10 @@ json FramesJson(const RunFolder& run, double t0) {
       for (const auto& k : ints) cols[k].push_back(f.at(k).get<int>());
       for (const auto& k : optional_ints) cols[k].push_back(f.value(k, -1));
       const std::string quality = f.value("pose_quality", std::string("good"));
-      cols["weak"].push_back(quality == "few_static_points" ? 1 : quality == "motion_model" ? 2 : 0);
+      cols["weak"].push_back(quality == "few_static_points" ? 1
+                             : quality == "motion_model" ? 2
+                             : quality == "depth_odometry" ? 3
+                                                          : 0);
       // "filter" and "ms" may be absent, but then from every frame (checked below).
       if (f.contains("filter")) {
         for (const auto& [name, value] : f["filter"].items()) {

@@ -269,14 +269,16 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
   j["lost"] = report.lost;
   {
     // Tracked frames by what their pose rests on, and the geometric test's totals.
-    int few = 0, motion = 0, geometric_dynamic = 0, geometric_culled = 0;
+    int few = 0, motion = 0, odometry = 0, geometric_dynamic = 0, geometric_culled = 0;
     for (const FrameReport& f : report.per_frame) {
       few += f.tracked && f.quality == PoseQuality::kFewInliers;
       motion += f.tracked && f.quality == PoseQuality::kMotionModel;
+      odometry += f.tracked && f.quality == PoseQuality::kDepthOdometry;
       geometric_dynamic += f.geometric_dynamic;
       geometric_culled += f.geometric_culled;
     }
-    j["weak_poses"] = {{"few_static_points", few}, {"motion_model", motion}};
+    j["weak_poses"] = {
+        {"few_static_points", few}, {"motion_model", motion}, {"depth_odometry", odometry}};
     j["geometric_test"] = {{"enabled", o.tracking.static_test},
                            {"matches_judged_dynamic", geometric_dynamic},
                            {"map_points_culled", geometric_culled}};

@@ -154,6 +154,9 @@ struct TrackingOptions {
   // ten-odd points inherits their depth errors, and a jump it teaches is repeated by the next
   // weak frames (bonn-crowd-a, FastDepth: 0.4-0.9 m excursions within 10 frames).
   bool weak_pose_sets_velocity = true;
+  // Off the map (nothing for the motion model's pose to rest on), the pose measured on the last
+  // frame's depths, if it has any, instead of the constant-velocity prediction.
+  bool depth_odometry = true;
   // Localisation only (--load-map --localize-only), where the camera leaves the loaded map:
   // true keeps a temporary local map in memory (keyframes and points made there, local BA with
   // the loaded keyframes and points held fixed; never saved, no loop closed), as ORB-SLAM3's

@@ -17,6 +17,7 @@
 #include "ademono/optimize/pose_optimizer.h"
 #include "ademono/slam/keyframe.h"
 #include "ademono/slam/matcher.h"
+#include "ademono/slam/motion_model.h"
 #include "ademono/slam/static_probability.h"
 
 namespace ademono {
@@ -56,6 +57,8 @@ const char* PoseQualityName(PoseQuality quality) {
       return "few_static_points";
     case PoseQuality::kMotionModel:
       return "motion_model";
+    case PoseQuality::kDepthOdometry:
+      return "depth_odometry";
   }
   throw std::logic_error("PoseQualityName: unknown quality");
 }
@@ -88,6 +91,14 @@ std::optional<Rigid3d> Tracking::PredictNext() const {
   return *velocity_ * *last_frame_->cam_from_world;
 }
 
+std::optional<Rigid3d> Tracking::MeanRecentVelocity() const {
+  if (recent_good_.size() < 2) return std::nullopt;
+  const auto& [old_id, cam_old_from_world] = recent_good_.front();
+  const auto& [new_id, cam_new_from_world] = recent_good_.back();
+  return MeanFrameMotion(cam_old_from_world, cam_new_from_world,
+                         static_cast<double>(new_id - old_id));
+}
+
 int Tracking::CountDepthPoints(const Frame& frame) const {
   int n = 0;
   for (float d : frame.F().depth) n += d > 0 ? 1 : 0;
@@ -99,6 +110,7 @@ void Tracking::FollowLoopCorrection() {
   loop_corrections_seen_ = map_.LoopCorrections();
   if (records_.empty() || !records_.back().tracked || records_.back().reference == nullptr) return;
   // The velocity is relative and stays; absolute poses follow the reference keyframe.
+  recent_good_.clear();
   const Rigid3d corrected =
       Map::ResolvePose(records_.back().reference, records_.back().cam_from_reference);
   if (last_frame_ && last_frame_->cam_from_world) last_frame_->cam_from_world = corrected;
@@ -220,8 +232,23 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // Degrade instead of dropping the frame (a short gap in the crowd, not a loss).
       if (!ok && predicted && weak_streak_ < options_.tracking.weak_pose_max_frames) {
         ok = weak = true;
-        if (frame.cam_from_world && matches_inliers_ >= options_.tracking.weak_pose_min_inliers) {
+        if (weak_streak_ == 0) {
+          // Into a gap: the motion of the last good frames on average, not the last frame's
+          // step, which a pose on the crowd's last few points can get centimetres wrong.
+          if (const std::optional<Rigid3d> mean = MeanRecentVelocity()) {
+            velocity_ = *mean;
+            predicted = PredictNext();
+          }
+        }
+        const bool on_map =
+            frame.cam_from_world && matches_inliers_ >= options_.tracking.weak_pose_min_inliers;
+        int odometry_inliers = 0;
+        if (on_map) {
           out.quality = PoseQuality::kFewInliers;
+        } else if ((odometry_inliers = TrackLastFrameDepth(frame)) > 0) {
+          // Off the map: measured on the last frame's depths rather than extrapolated.
+          matches_inliers_ = odometry_inliers;
+          out.quality = PoseQuality::kDepthOdometry;
         } else {
           out.quality = PoseQuality::kMotionModel;
           frame.cam_from_world = *predicted;
@@ -247,6 +274,10 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       lost_streak_ = 0;
       weak_streak_ = weak ? weak_streak_ + 1 : 0;
       if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
+      if (!weak) {
+        recent_good_.emplace_back(frame.id, *frame.cam_from_world);
+        if (recent_good_.size() > 6) recent_good_.pop_front();
+      }
       out.match_state = MatchStates(frame);
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
       // ones fixed; they are never saved).
@@ -280,6 +311,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     } else {
       state_ = TrackingState::kLost;
       velocity_.reset();
+      recent_good_.clear();
       weak_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
@@ -368,6 +400,7 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
     if (p) local_points_.push_back(p);
   }
   velocity_.reset();
+  recent_good_.clear();
   state_ = TrackingState::kOk;
   matches_inliers_ = static_cast<int>(local_points_.size());
   return true;
@@ -386,6 +419,7 @@ bool Tracking::InitialiseMonocular(Frame& frame) {
     if (p) local_points_.push_back(p);
   }
   velocity_.reset();
+  recent_good_.clear();
   state_ = TrackingState::kOk;
   matches_inliers_ = static_cast<int>(local_points_.size());
   return true;
@@ -493,6 +527,7 @@ void Tracking::RescaleWorld(Frame& frame, double factor) {
   }
   if (last_frame_ && last_frame_->cam_from_world) scale_translation(*last_frame_->cam_from_world);
   if (velocity_) scale_translation(*velocity_);
+  for (auto& [id, pose] : recent_good_) scale_translation(pose);
   if (last_good_pose_) scale_translation(*last_good_pose_);
   scale_translation(*frame.cam_from_world);
   frame.features = RescaleDepth(frame.F(), static_cast<float>(factor));
@@ -555,16 +590,41 @@ void Tracking::AddVisualOdometryPoints(Frame& frame) {
   }
 }
 
-bool Tracking::TrackWithMotionModel(Frame& frame) {
+int Tracking::TrackLastFrameDepth(Frame& frame) {
+  if (!options_.tracking.depth_odometry || !velocity_ || !last_frame_ ||
+      !last_frame_->cam_from_world)
+    return 0;
+  // The last frame's own depths as points that live only for this search (ORB-SLAM2's visual
+  // odometry points): the pose is measured on them, never extrapolated.
+  Frame last = *last_frame_;
+  AddVisualOdometryPoints(last);
+  Frame attempt = frame;
+  std::fill(attempt.map_points.begin(), attempt.map_points.end(), nullptr);
+  if (!MatchLastFrame(attempt, last)) return 0;
+  OptimizeFramePose(attempt);
+  DiscardOutliers(attempt);
+  const int inliers = CountInliers(attempt);
+  if (inliers < kMinOdometryPoints) return 0;
+  // Only the pose is kept: the odometry points never reach a keyframe or the next search.
+  frame.cam_from_world = attempt.cam_from_world;
+  std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
+  return inliers;
+}
+
+bool Tracking::MatchLastFrame(Frame& frame, const Frame& last) const {
   const Matcher matcher(0.9f, true);
-  frame.cam_from_world = *velocity_ * *last_frame_->cam_from_world;
+  frame.cam_from_world = *velocity_ * *last.cam_from_world;
   const float radius = static_cast<float>(options_.tracking.motion_search_radius);
-  int matches = matcher.SearchByProjection(frame, *last_frame_, radius);
+  int matches = matcher.SearchByProjection(frame, last, radius);
   if (matches < options_.tracking.min_motion_matches) {
     std::fill(frame.map_points.begin(), frame.map_points.end(), nullptr);
-    matches = matcher.SearchByProjection(frame, *last_frame_, 2 * radius);
+    matches = matcher.SearchByProjection(frame, last, 2 * radius);
   }
-  if (matches < options_.tracking.min_motion_matches) return false;
+  return matches >= options_.tracking.min_motion_matches;
+}
+
+bool Tracking::TrackWithMotionModel(Frame& frame) {
+  if (!MatchLastFrame(frame, *last_frame_)) return false;
   OptimizeFramePose(frame);
   const int in_map = DiscardOutliers(frame);
   if (odometry_localisation_) {

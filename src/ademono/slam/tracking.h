@@ -8,6 +8,7 @@
 // Every call runs with the map mutex held by the caller.
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -28,9 +29,11 @@ const char* TrackingStateName(TrackingState state);
 // How much a tracked frame's pose rests on: kGood (enough static inliers against the local map),
 // kFewInliers (tracking failed its inlier bar but the pose is optimised on what is left, e.g.
 // when people fill the view), kMotionModel (nothing left to optimise on: the constant-velocity
-// prediction). Weak poses (the latter two) are reported, never made keyframes.
-enum class PoseQuality { kGood, kFewInliers, kMotionModel };
-// "good" | "few_static_points" | "motion_model" (summary.json per_frame, report.html).
+// prediction), kDepthOdometry (off the map, the pose optimised on points made of the last frame's
+// depths; tracking.depth_odometry). Weak poses (all but kGood) are reported, never made keyframes.
+enum class PoseQuality { kGood, kFewInliers, kMotionModel, kDepthOdometry };
+// "good" | "few_static_points" | "motion_model" | "depth_odometry" (summary.json per_frame,
+// report.html).
 const char* PoseQualityName(PoseQuality quality);
 
 // What became of one keypoint of a tracked frame in the pose (for scoring against synthetic
@@ -100,6 +103,8 @@ class Tracking {
   const std::vector<FrameRecord>& Records() const { return records_; }
   // Constant-velocity prediction of the next frame's pose (if tracking is OK).
   std::optional<Rigid3d> PredictNext() const;
+  // The mean per-frame motion over the last good frames (recent_good_); nullopt with fewer than 2.
+  std::optional<Rigid3d> MeanRecentVelocity() const;
   const std::optional<Frame>& LastFrame() const { return last_frame_; }
   int NumLost() const { return num_lost_; }
   int NumRelocalisations() const { return num_relocalisations_; }
@@ -127,6 +132,12 @@ class Tracking {
   // in the monocular core never (its points come from triangulation in local mapping).
   bool KeyFramePointsFromDepth() const { return !options_.tracking.monocular; }
   bool TrackWithMotionModel(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // Projection search of `last`'s points from the constant-velocity prediction (radius, then
+  // twice it); true with at least tracking.min_motion_matches matches.
+  bool MatchLastFrame(Frame& frame, const Frame& last) const ADEMONO_REQUIRES(map_.mutex);
+  // Off the map: the pose optimised on the last frame's depths made points (a copy; nothing
+  // reaches the map). Its inliers, 0 (pose untouched) below kMinOdometryPoints.
+  int TrackLastFrameDepth(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool TrackReferenceKeyFrame(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool TrackLocalMap(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool Relocalise(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
@@ -188,6 +199,8 @@ class Tracking {
   uint64_t next_frame_id_ = 0;
   uint64_t loop_corrections_seen_ = 0;
   std::optional<Frame> last_frame_;
+  // The last good frames' (id, cam_from_world), oldest first, for MeanRecentVelocity.
+  std::deque<std::pair<uint64_t, Rigid3d>> recent_good_;
   std::optional<Rigid3d> velocity_;        // current_from_last
   std::optional<Rigid3d> last_good_pose_;  // cam_from_world of the last tracked frame
   KeyFrame* reference_keyframe_ = nullptr;

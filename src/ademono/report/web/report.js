@@ -426,7 +426,8 @@
         fmt((F.loop || []).reduce((a, b) => a + b, 0), 0) + ' loops, ' +
         fmt(F.state.filter((s) => s === 2).length, 0) + ' lost frames, ' +
         fmt((F.weak || []).filter((w) => w === 1).length, 0) + ' weak poses on few static points, ' +
-        fmt((F.weak || []).filter((w) => w === 2).length, 0) + ' on the motion model alone')));
+        fmt((F.weak || []).filter((w) => w === 2).length, 0) + ' on the motion model alone, ' +
+        fmt((F.weak || []).filter((w) => w === 3).length, 0) + ' on the last frame\'s depths (off the map)')));
     const tl = el('div', { id: 'plot-timeline' });
     tlPanel.appendChild(tl);
     // Negative counts mean "not recorded": such series are left out.
