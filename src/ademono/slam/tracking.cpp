@@ -25,8 +25,10 @@ namespace {
 
 // Static probability of a point with a history: about four agreeing frames more than against.
 constexpr double kTrustedStaticProbability = 0.8;
-// Localisation only: map and odometry points a frame needs to be tracked by odometry.
+// Localisation only, and depth odometry off the map: the points a frame's odometry pose needs.
 constexpr int kMinOdometryPoints = 20;
+// Good frames whose span gives the mean velocity into a gap (five frames of motion).
+constexpr size_t kMeanVelocityFrames = 6;
 
 // Matched points (map or odometry) that are not outliers.
 int CountInliers(const Frame& frame) {
@@ -242,11 +244,11 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         }
         const bool on_map =
             frame.cam_from_world && matches_inliers_ >= options_.tracking.weak_pose_min_inliers;
-        int odometry_inliers = 0;
+        // Off the map: measured on the last frame's depths rather than extrapolated.
+        const int odometry_inliers = on_map ? 0 : TrackLastFrameDepth(frame);
         if (on_map) {
           out.quality = PoseQuality::kFewInliers;
-        } else if ((odometry_inliers = TrackLastFrameDepth(frame)) > 0) {
-          // Off the map: measured on the last frame's depths rather than extrapolated.
+        } else if (odometry_inliers > 0) {
           matches_inliers_ = odometry_inliers;
           out.quality = PoseQuality::kDepthOdometry;
         } else {
@@ -276,7 +278,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
       if (!weak) {
         recent_good_.emplace_back(frame.id, *frame.cam_from_world);
-        if (recent_good_.size() > 6) recent_good_.pop_front();
+        if (recent_good_.size() > kMeanVelocityFrames) recent_good_.pop_front();
       }
       out.match_state = MatchStates(frame);
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded

@@ -103,8 +103,6 @@ class Tracking {
   const std::vector<FrameRecord>& Records() const { return records_; }
   // Constant-velocity prediction of the next frame's pose (if tracking is OK).
   std::optional<Rigid3d> PredictNext() const;
-  // The mean per-frame motion over the last good frames (recent_good_); nullopt with fewer than 2.
-  std::optional<Rigid3d> MeanRecentVelocity() const;
   const std::optional<Frame>& LastFrame() const { return last_frame_; }
   int NumLost() const { return num_lost_; }
   int NumRelocalisations() const { return num_relocalisations_; }
@@ -132,6 +130,8 @@ class Tracking {
   // in the monocular core never (its points come from triangulation in local mapping).
   bool KeyFramePointsFromDepth() const { return !options_.tracking.monocular; }
   bool TrackWithMotionModel(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // The mean per-frame motion over the last good frames (recent_good_); nullopt with fewer than 2.
+  std::optional<Rigid3d> MeanRecentVelocity() const;
   // Projection search of `last`'s points from the constant-velocity prediction (radius, then
   // twice it); true with at least tracking.min_motion_matches matches.
   bool MatchLastFrame(Frame& frame, const Frame& last) const ADEMONO_REQUIRES(map_.mutex);
