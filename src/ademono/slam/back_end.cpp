@@ -203,7 +203,7 @@ Trajectory BackEnd::FrameTrajectory() const {
   Trajectory trajectory;
   for (const FrameRecord& r : tracking_.Records()) {
     if (!r.tracked || r.reference == nullptr) continue;
-    const Rigid3d cam_from_world = Map::ResolvePose(r.reference, r.cam_from_reference);
+    const Rigid3d cam_from_world = ResolveFramePose(r);
     trajectory.push_back({r.timestamp, cam_from_world.inverse()});
   }
   return trajectory;

@@ -157,6 +157,10 @@ struct TrackingOptions {
   // Off the map (nothing for the motion model's pose to rest on), the pose measured on the last
   // frame's depths, if it has any, instead of the constant-velocity prediction.
   bool depth_odometry = true;
+  // The trajectory's frames between two keyframes follow both keyframes' later corrections,
+  // blended by time (ResolveFramePose), instead of their reference keyframe's alone. On in the
+  // monocular families, whose young triangulated points move most after a frame is tracked.
+  bool interpolate_trajectory = false;
   // Localisation only (--load-map --localize-only), where the camera leaves the loaded map:
   // true keeps a temporary local map in memory (keyframes and points made there, local BA with
   // the loaded keyframes and points held fixed; never saved, no loop closed), as ORB-SLAM3's

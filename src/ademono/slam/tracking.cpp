@@ -12,6 +12,7 @@
 
 #include "ademono/core/cv_geometry.h"
 #include "ademono/core/statistics.h"
+#include "ademono/io/timed_poses.h"
 #include "ademono/optimize/depth_scale.h"
 #include "ademono/optimize/ground_plane.h"
 #include "ademono/optimize/pose_optimizer.h"
@@ -355,6 +356,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
   } else if (state_ != TrackingState::kNotInitialized) {
     ++num_lost_;
   }
+  if (ok && options_.tracking.interpolate_trajectory && !localize_only_) {
+    AnchorBetweenKeyFrames(record, *frame.cam_from_world, out.new_keyframe.get());
+  }
   records_.push_back(record);
   if (ok) {
     last_frame_ = std::move(frame);
@@ -520,11 +524,50 @@ bool Tracking::Triangulated(const MapPoint& point) const {
   return false;
 }
 
+void Tracking::AnchorBetweenKeyFrames(FrameRecord& record, const Rigid3d& cam_from_world,
+                                      KeyFrame* new_keyframe) {
+  if (new_keyframe != nullptr) {
+    // The frames since the last keyframe now have the keyframe after them.
+    if (newest_keyframe_ != nullptr) {
+      for (size_t i = newest_keyframe_record_ + 1; i < records_.size(); ++i) {
+        FrameRecord& r = records_[i];
+        if (!r.tracked || r.previous_keyframe != newest_keyframe_) continue;
+        r.next_keyframe = new_keyframe;
+        r.cam_from_next = r.cam_from_previous * newest_keyframe_->cam_from_world *
+                          new_keyframe->cam_from_world.inverse();
+      }
+    }
+    newest_keyframe_ = new_keyframe;
+    newest_keyframe_record_ = records_.size();  // this record's index once pushed
+  }
+  if (newest_keyframe_ == nullptr) return;
+  record.previous_keyframe = newest_keyframe_;
+  record.cam_from_previous = cam_from_world * newest_keyframe_->cam_from_world.inverse();
+}
+
+Rigid3d ResolveFramePose(const FrameRecord& record) {
+  const Rigid3d from_reference = Map::ResolvePose(record.reference, record.cam_from_reference);
+  const KeyFrame* previous = record.previous_keyframe;
+  const KeyFrame* next = record.next_keyframe;
+  if (previous == nullptr || next == nullptr || next->timestamp <= previous->timestamp) {
+    return from_reference;
+  }
+  const double alpha = std::clamp(
+      (record.timestamp - previous->timestamp) / (next->timestamp - previous->timestamp), 0.0,
+      1.0);
+  const Rigid3d world_from_cam_a =
+      Map::ResolvePose(previous, record.cam_from_previous).inverse();
+  const Rigid3d world_from_cam_b = Map::ResolvePose(next, record.cam_from_next).inverse();
+  return InterpolatePose(world_from_cam_a, world_from_cam_b, alpha).inverse();
+}
+
 void Tracking::RescaleWorld(Frame& frame, double factor) {
   map_.Rescale(factor);
   auto scale_translation = [factor](Rigid3d& pose) { pose.translation() *= factor; };
   for (FrameRecord& r : records_) {
     scale_translation(r.cam_from_reference);
+    scale_translation(r.cam_from_previous);
+    scale_translation(r.cam_from_next);
     r.depth_scale *= factor;
   }
   if (last_frame_ && last_frame_->cam_from_world) scale_translation(*last_frame_->cam_from_world);

@@ -57,8 +57,20 @@ struct FrameRecord {
   bool tracked = false;
   KeyFrame* reference = nullptr;  // owned by the map (never freed while the map lives)
   Rigid3d cam_from_reference = Rigid3d::Identity();
+  // tracking.interpolate_trajectory: the newest keyframe when the frame was tracked and the
+  // next one made after it, each with the frame's pose relative to it then (null until made).
+  KeyFrame* previous_keyframe = nullptr;
+  Rigid3d cam_from_previous = Rigid3d::Identity();
+  KeyFrame* next_keyframe = nullptr;
+  Rigid3d cam_from_next = Rigid3d::Identity();
   double depth_scale = 1.0;  // network depth: the factor its depths were corrected by
 };
+
+// A tracked frame's pose in the map as it is now. With both keyframes around it (between a
+// keyframe and the next), the two keyframes' poses relative to it blended by time: the frame
+// follows what local BA has since learnt about the keyframes on either side, not only about
+// its reference. Otherwise it follows its reference keyframe (ORB-SLAM's).
+Rigid3d ResolveFramePose(const FrameRecord& record);
 
 struct TrackingOutput {
   bool tracked = false;
@@ -233,7 +245,15 @@ class Tracking {
   void AddVisualOdometryPoints(Frame& frame);
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<std::shared_ptr<MapPoint>> local_points_;
+  // tracking.interpolate_trajectory: `record` (about to be pushed) is anchored to the newest
+  // keyframe, and the records since the previous keyframe to `new_keyframe` when one was made.
+  void AnchorBetweenKeyFrames(FrameRecord& record, const Rigid3d& cam_from_world,
+                              KeyFrame* new_keyframe);
   std::vector<FrameRecord> records_;
+  // The newest keyframe tracking made and the index of its frame's record
+  // (tracking.interpolate_trajectory).
+  KeyFrame* newest_keyframe_ = nullptr;
+  size_t newest_keyframe_record_ = 0;
   MonocularInitialization monocular_initialization_;
 };
 
