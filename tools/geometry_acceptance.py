@@ -235,6 +235,13 @@ def main():
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
             ]
+            # Frames between keyframes: on indoors, off outdoors (the families' choice).
+            if r == "seqa":
+                ablation.append((r, "reference_anchor",
+                                 ["--set", "tracking.interpolate_trajectory=false"]))
+            else:
+                ablation.append((r, "interpolated_frames",
+                                 ["--set", "tracking.interpolate_trajectory=true"]))
             if r == "kitti":
                 ablation.append((r, "no_ground_in_ba", ["--set", "depth.ground_in_ba=false"]))
                 ablation.append((r, "held_ground_normal",

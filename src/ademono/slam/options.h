@@ -158,8 +158,8 @@ struct TrackingOptions {
   // frame's depths, if it has any, instead of the constant-velocity prediction.
   bool depth_odometry = true;
   // The trajectory's frames between two keyframes follow both keyframes' later corrections,
-  // blended by time (ResolveFramePose), instead of their reference keyframe's alone. On in the
-  // monocular families, whose young triangulated points move most after a frame is tracked.
+  // blended by time (ResolveFramePose), instead of their reference keyframe's alone. On in
+  // network_indoor.yaml, whose young triangulated points move most after a frame is tracked.
   bool interpolate_trajectory = false;
   // Localisation only (--load-map --localize-only), where the camera leaves the loaded map:
   // true keeps a temporary local map in memory (keyframes and points made there, local BA with
