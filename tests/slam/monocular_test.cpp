@@ -47,6 +47,7 @@ SystemOptions Options(DepthInput input) {
   options.mapping.cull_min_observations = 3;
   options.mapping.triangulation_neighbours = 20;
   options.mapping.triangulation_match_ratio = 0.8;
+  options.tracking.interpolate_trajectory = true;  // as network_indoor.yaml
   if (input == DepthInput::kNone) options.depth.error_relative = 0;
   return options;
 }
@@ -100,7 +101,7 @@ OfficeRun OnFramesOf(const OfficeRun& run, const OfficeRun& reference) {
   return out;
 }
 
-TEST(MonocularTest, GeometryAloneIsWithinThreeTimesExactDepth) {
+TEST(MonocularTest, GeometryAloneIsWithinTwiceExactDepth) {
   const size_t frames = 150;
   const OfficeRun exact = RunOffice(DepthInput::kExact, frames, {});
   const OfficeRun none = RunOffice(DepthInput::kNone, frames, {});
@@ -117,9 +118,10 @@ TEST(MonocularTest, GeometryAloneIsWithinThreeTimesExactDepth) {
   const double none_sim3 = Ate(none, Alignment::kSim3).ape.rmse;
   RecordProperty("exact_sim3_um", static_cast<int>(exact_sim3 * 1e6));
   RecordProperty("none_sim3_um", static_cast<int>(none_sim3 * 1e6));
-  // Measured: 7.6 mm against 3.1 mm. Without depth the map's scale drifts, which one sim3 scale
-  // cannot take out; with depth every frame measures it.
-  EXPECT_LE(none_sim3, 3.0 * exact_sim3) << "exact " << exact_sim3 << " none " << none_sim3;
+  // Measured: 4.5 mm against 2.7 mm (1.67x; issue 28 asks 1.5x), and 7.6 mm before frames
+  // followed the keyframes around them (tracking.interpolate_trajectory). Without depth the
+  // map's scale drifts, which one sim3 scale cannot take out; with depth every frame measures it.
+  EXPECT_LE(none_sim3, 2.0 * exact_sim3) << "exact " << exact_sim3 << " none " << none_sim3;
   EXPECT_LE(none_sim3, 0.01) << "metres, at the sim3 scale";
 
   // Local mapping's hand-off clock counts tracked frames, whatever they are numbered: a run that
