@@ -52,7 +52,8 @@ struct FrameReport {
   bool keyframe = false;
   int keypoints = 0, kept = 0, with_depth = 0, inliers = 0, dynamic_points_culled = 0;
   // Tracked frames: what the pose rests on ("good", "few_static_points", "motion_model",
-  // "depth_odometry"; the static points are `inliers`), and the geometric test's verdicts (slam/static_probability.h).
+  // "depth_odometry"; the static points are `inliers`), and the geometric test's verdicts
+  // (slam/static_probability.h).
   PoseQuality quality = PoseQuality::kGood;
   int geometric_dynamic = 0, geometric_culled = 0;
   // Network depth: the factor its depths were corrected by, against the final map (absent for

@@ -102,6 +102,11 @@ std::optional<Rigid3d> Tracking::MeanRecentVelocity() const {
                          static_cast<double>(new_id - old_id));
 }
 
+void Tracking::ForgetMotion() {
+  velocity_.reset();
+  recent_good_.clear();
+}
+
 int Tracking::CountDepthPoints(const Frame& frame) const {
   int n = 0;
   for (float d : frame.F().depth) n += d > 0 ? 1 : 0;
@@ -313,8 +318,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       if (odometry_localisation_) AddVisualOdometryPoints(frame);
     } else {
       state_ = TrackingState::kLost;
-      velocity_.reset();
-      recent_good_.clear();
+      ForgetMotion();
       weak_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
@@ -405,8 +409,7 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   for (const auto& p : kf->map_points) {
     if (p) local_points_.push_back(p);
   }
-  velocity_.reset();
-  recent_good_.clear();
+  ForgetMotion();
   state_ = TrackingState::kOk;
   matches_inliers_ = static_cast<int>(local_points_.size());
   return true;
@@ -424,8 +427,7 @@ bool Tracking::InitialiseMonocular(Frame& frame) {
   for (const auto& p : keyframes->second->map_points) {
     if (p) local_points_.push_back(p);
   }
-  velocity_.reset();
-  recent_good_.clear();
+  ForgetMotion();
   state_ = TrackingState::kOk;
   matches_inliers_ = static_cast<int>(local_points_.size());
   return true;
