@@ -319,6 +319,9 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     } else {
       state_ = TrackingState::kLost;
       ForgetMotion();
+      // The frames before a loss are not blended with whatever keyframe comes after it (a new
+      // start, or a relocalisation elsewhere): they keep their reference keyframe.
+      newest_keyframe_ = nullptr;
       weak_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
