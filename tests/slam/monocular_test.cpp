@@ -48,6 +48,7 @@ SystemOptions Options(DepthInput input) {
   options.mapping.triangulation_neighbours = 20;
   options.mapping.triangulation_match_ratio = 0.8;
   options.tracking.interpolate_trajectory = true;  // as network_indoor.yaml
+  options.mapping.triangulation_depth_sigmas = 0;  // as network_indoor.yaml
   if (input == DepthInput::kNone) options.depth.error_relative = 0;
   return options;
 }
