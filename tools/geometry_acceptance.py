@@ -236,12 +236,22 @@ def main():
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
             ]
             # Frames between keyframes: on indoors, off outdoors (the families' choice).
+            # Frames between keyframes, the keyframe scale prior and the epipolar search's band
+            # around the network's depth differ between the families: each flipped.
             if r == "seqa":
                 ablation.append((r, "reference_anchor",
                                  ["--set", "tracking.interpolate_trajectory=false"]))
+                ablation.append((r, "no_scale_prior",
+                                 ["--set", "mapping.network_scale_prior=false"]))
+                ablation.append((r, "network_band",
+                                 ["--set", "mapping.triangulation_depth_sigmas=3"]))
             else:
                 ablation.append((r, "interpolated_frames",
                                  ["--set", "tracking.interpolate_trajectory=true"]))
+                ablation.append((r, "scale_prior",
+                                 ["--set", "mapping.network_scale_prior=true"]))
+                ablation.append((r, "no_network_band",
+                                 ["--set", "mapping.triangulation_depth_sigmas=0"]))
             if r == "kitti":
                 ablation.append((r, "no_ground_in_ba", ["--set", "depth.ground_in_ba=false"]))
                 ablation.append((r, "held_ground_normal",

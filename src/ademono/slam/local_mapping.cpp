@@ -417,6 +417,21 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     const bool any_ground =
         std::any_of(cameras.begin(), cameras.end(), [](const auto& kf) { return kf && kf->ground; });
     std::map<uint64_t, size_t> point_index_of;
+    // mapping.network_scale_prior: the relative sigma of each network depth of a free keyframe.
+    std::map<const KeyFrame*, double> scale_prior_sigma;
+    if (monocular_ && options_.network_scale_prior) {
+      if (const std::optional<double> spread = KeyFrameScaleSpread()) {
+        std::map<const KeyFrame*, int> depths;
+        for (MapPoint* p : local_points) {
+          for (const auto& [kf, idx] : p->observations) {
+            if (kf->ba_local_for == keyframe.id && kf->id != 0 && !kf->frozen &&
+                kf->F().DepthIsPrior() && kf->F().depth[idx] > 0)
+              ++depths[kf];
+          }
+        }
+        for (const auto& [kf, n] : depths) scale_prior_sigma[kf] = *spread * std::sqrt(n);
+      }
+    }
     for (MapPoint* p : local_points) {
       const size_t point_index = problem.points.size();
       if (any_ground) point_index_of[p->id] = point_index;
@@ -429,9 +444,15 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         // The network's depth holds the point only where geometry cannot yet.
         const bool prior = monocular_ && options_.network_priors && p->depth_prior &&
                            kf == p->reference && kf->F().depth[idx] > 0 && PriorActive(*p);
-        problem.observations.push_back(
-            {it->second, point_index,
-             prior ? NetworkPrior(*kf, idx) : kf->F().Observation(idx)});
+        ImageObservation observation = prior ? NetworkPrior(*kf, idx) : kf->F().Observation(idx);
+        const auto scale_prior = scale_prior_sigma.find(kf);
+        if (!prior && scale_prior != scale_prior_sigma.end() && kf->F().depth[idx] > 0) {
+          // The network's own reading: the anchor holds the map at its long-run scale.
+          const FrameFeatures& f = kf->F();
+          const double z = f.depth[idx] / f.depth_scale;
+          observation = f.PriorObservation(idx, z, scale_prior->second * z);
+        }
+        problem.observations.push_back({it->second, point_index, observation});
         observation_refs.emplace_back(kf, idx);
       }
     }
@@ -528,6 +549,20 @@ double LocalMapping::NetworkSigmaLog() const {
   const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;
   return Median(std::vector<double>(sigma_logs_.begin() + static_cast<long>(start),
                                     sigma_logs_.end()));
+}
+
+std::optional<double> LocalMapping::KeyFrameScaleSpread() const {
+  std::vector<double> logs;
+  for (const auto& [id, kf] : map_.KeyFrames()) {
+    if (!kf->bad && kf->F().DepthIsPrior() && kf->F().depth_scale > 0)
+      logs.push_back(std::log(kf->F().depth_scale));
+  }
+  if (logs.size() < 5) return std::nullopt;
+  const double median = Median(logs);
+  for (double& v : logs) v = std::abs(v - median);
+  const double spread = 1.4826 * Median(logs);
+  if (!(spread > 0)) return std::nullopt;
+  return spread;
 }
 
 bool LocalMapping::PriorActive(const MapPoint& p) const {

@@ -216,6 +216,11 @@ struct MappingOptions {
   // configured error model (network_error_model). Off: the ablation of each.
   bool network_priors = true;
   bool network_error_model = true;
+  // The network's scale per keyframe in local BA: every network depth of a free keyframe enters
+  // as a prior whose sigma is the keyframe scale's measured spread (robust, over the map's
+  // keyframes) times sqrt(n) of its n depths, so together they hold the keyframe's scale as one
+  // observation and alone none pulls a point's shape (the network's error is correlated).
+  bool network_scale_prior = false;
   BundleAdjustmentOptions ba;  // keys ba_first_iterations, ba_second_iterations
   void Check() const;
   static MappingOptions FromYaml(const YAML::Node& node);
