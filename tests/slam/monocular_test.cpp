@@ -49,14 +49,13 @@ SystemOptions Options(DepthInput input) {
   options.mapping.triangulation_match_ratio = 0.8;
   options.tracking.interpolate_trajectory = true;  // as network_indoor.yaml
   options.mapping.triangulation_depth_sigmas = 0;  // as network_indoor.yaml
-  options.mapping.network_scale_prior = true;     // as network_indoor.yaml
   if (input == DepthInput::kNone) options.depth.error_relative = 0;
   return options;
 }
 
 // `first_index`: the number of the run's first frame (a run need not start at frame 0).
 OfficeRun RunOffice(DepthInput input, size_t frames, const SimulatedDepthOptions& network,
-                    size_t first_index = 0, bool scale_prior = true) {
+                    size_t first_index = 0, bool scale_prior = false) {
   const synth::SceneOptions scene_options = Office(frames);
   const synth::Scene scene = synth::BuildScene(scene_options);
   const SimulatedDepthProvider provider(network, nullptr);
