@@ -235,21 +235,18 @@ def main():
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
             ]
-            # Frames between keyframes: on indoors, off outdoors (the families' choice).
+            # The keyframe scale prior, off in both families, on.
+            ablation.append((r, "scale_prior", ["--set", "mapping.network_scale_prior=true"]))
             # Frames between keyframes and the epipolar search's band around the network's depth
-            # differ between the families: each flipped; the keyframe scale prior (off in both) on.
+            # differ between the families: each flipped.
             if r == "seqa":
                 ablation.append((r, "reference_anchor",
                                  ["--set", "tracking.interpolate_trajectory=false"]))
-                ablation.append((r, "scale_prior",
-                                 ["--set", "mapping.network_scale_prior=true"]))
                 ablation.append((r, "network_band",
                                  ["--set", "mapping.triangulation_depth_sigmas=3"]))
             else:
                 ablation.append((r, "interpolated_frames",
                                  ["--set", "tracking.interpolate_trajectory=true"]))
-                ablation.append((r, "scale_prior",
-                                 ["--set", "mapping.network_scale_prior=true"]))
                 ablation.append((r, "no_network_band",
                                  ["--set", "mapping.triangulation_depth_sigmas=0"]))
             if r == "kitti":
