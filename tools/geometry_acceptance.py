@@ -116,6 +116,7 @@ class Rows:
             return self.model(row)
         cache = os.path.join(self.out, "cache", row)
         if not os.path.isdir(os.path.join(cache, "depth")):
+            os.makedirs(os.path.dirname(cache), exist_ok=True)
             cmd = [self.a.bin, "infer", "--dataset", self.dataset(row), "--depth-model",
                    self.model(row), "--out", cache]
             if row == "bonn":

@@ -1,6 +1,7 @@
 #include "ademono/core/statistics.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace ademono {
 
@@ -12,6 +13,13 @@ double Median(std::vector<double> values) {
   const double upper = *mid;
   if (n % 2 == 1) return upper;
   return 0.5 * (upper + *std::max_element(values.begin(), mid));
+}
+
+double RobustSpread(const std::vector<double>& values, double centre) {
+  std::vector<double> deviations;
+  deviations.reserve(values.size());
+  for (double v : values) deviations.push_back(std::abs(v - centre));
+  return 1.4826 * Median(std::move(deviations));
 }
 
 }  // namespace ademono

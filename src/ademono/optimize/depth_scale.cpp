@@ -33,9 +33,7 @@ DepthScaleEstimate EstimateDepthScale(const std::vector<double>& reference,
   if (estimate.num_points < options.min_points) return estimate;
 
   const double median = Median(logs);
-  std::vector<double> deviations(logs.size());
-  for (size_t i = 0; i < logs.size(); ++i) deviations[i] = std::abs(logs[i] - median);
-  const double sigma = std::max(options.min_sigma, 1.4826 * Median(deviations));
+  const double sigma = std::max(options.min_sigma, RobustSpread(logs, median));
 
   // Huber IRLS on the location of the log ratios, started at the median.
   double mu = median;

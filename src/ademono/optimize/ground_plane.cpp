@@ -151,10 +151,7 @@ GroundPlane EstimateGroundPlane(const std::vector<Eigen::Vector3d>& points_cam,
   result.inlier_share = static_cast<double>(count) / static_cast<double>(n);
   // Spread of the last refit's residuals, and the height's standard error at that spread:
   // log height = log k - log(1 + a^2 + c^2) / 2.
-  std::vector<double> absolute(residuals.size());
-  const double centre = Median(residuals);
-  for (size_t i = 0; i < residuals.size(); ++i) absolute[i] = std::abs(residuals[i] - centre);
-  result.residual_sigma = 1.4826 * Median(absolute);
+  result.residual_sigma = RobustSpread(residuals, Median(residuals));
   const double q = 1.0 + a * a + c * c;
   const Eigen::Vector3d dlog_height(1.0, -a / q, -c / q);
   const Eigen::Matrix3d covariance = h.ldlt().solve(Eigen::Matrix3d::Identity());
@@ -253,9 +250,7 @@ GroundPlane GroundHeightAlong(const std::vector<Eigen::Vector3d>& points_cam,
   result.num_points = static_cast<int>(points_cam.size());
   result.num_inliers = static_cast<int>(log_residuals.size());
   result.inlier_share = static_cast<double>(result.num_inliers) / result.num_points;
-  std::vector<double> absolute;
-  for (double r : log_residuals) absolute.push_back(std::abs(r));
-  result.residual_sigma = 1.4826 * Median(absolute);
+  result.residual_sigma = RobustSpread(log_residuals);
   result.height_sigma =
       result.num_inliers > 0 ? result.residual_sigma / std::sqrt(result.num_inliers) : 0.0;
   result.confidence = result.inlier_share * std::exp(-result.height_sigma / 0.01);
@@ -454,9 +449,7 @@ GroundPlane EstimateGroundFromTwoViews(const cv::Mat& image_a, const cv::Mat& im
   result.num_points = used;
   result.num_inliers = inliers;
   result.inlier_share = used > 0 ? static_cast<double>(inliers) / used : 0.0;
-  std::vector<double> absolute(residuals.size());
-  for (size_t i = 0; i < residuals.size(); ++i) absolute[i] = std::abs(residuals[i]);
-  result.residual_sigma = 1.4826 * Median(absolute);
+  result.residual_sigma = RobustSpread(residuals);
   // The height's standard error at that spread: log h = -log |m|.
   const Eigen::Matrix<double, 5, 5> covariance =
       normal_matrix.ldlt().solve(Eigen::Matrix<double, 5, 5>::Identity());

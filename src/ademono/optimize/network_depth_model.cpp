@@ -16,13 +16,6 @@ double Quantile(std::vector<double> v, double q) {
   return v[k];
 }
 
-double RobustSigma(const std::vector<double>& residuals) {
-  std::vector<double> abs;
-  abs.reserve(residuals.size());
-  for (double r : residuals) abs.push_back(std::abs(r));
-  return 1.4826 * Median(abs);
-}
-
 }  // namespace
 
 InverseDepthAffine FitInverseDepthAffine(const std::vector<double>& map_depths,
@@ -53,7 +46,7 @@ InverseDepthAffine FitInverseDepthAffine(const std::vector<double>& map_depths,
   };
   compute_residuals();
   for (int it = 0; it < options.iterations; ++it) {
-    const double sigma = std::max(RobustSigma(residuals), 1e-6);
+    const double sigma = std::max(RobustSpread(residuals), 1e-6);
     // Huber first (convex: settles near the bulk), then Tukey's biweight, which gives points far
     // off (wrong matches, movers) no weight at all.
     const bool tukey = it >= 3;
@@ -93,14 +86,14 @@ InverseDepthAffine FitInverseDepthAffine(const std::vector<double>& map_depths,
   if (!(fit.a > 0) || !std::isfinite(fit.a) || !std::isfinite(fit.b)) return fit;
   // The spread of the points the fit kept (within 3 robust sigmas).
   std::vector<double> log_residuals;
-  const double sigma = RobustSigma(residuals);
+  const double sigma = RobustSpread(residuals);
   for (size_t i = 0; i < n; ++i) {
     if (std::abs(residuals[i]) > 3.0 * sigma) continue;
     ++fit.num_inliers;
     const double mapped = fit.Map(zn[i]);
     if (mapped > 0) log_residuals.push_back(std::log(zm[i] / mapped));
   }
-  fit.sigma_log = RobustSigma(log_residuals);
+  fit.sigma_log = RobustSpread(log_residuals);
   fit.valid = true;
   return fit;
 }

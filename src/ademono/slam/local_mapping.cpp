@@ -558,9 +558,7 @@ std::optional<double> LocalMapping::KeyFrameScaleSpread() const {
       logs.push_back(std::log(kf->F().depth_scale));
   }
   if (logs.size() < 5) return std::nullopt;
-  const double median = Median(logs);
-  for (double& v : logs) v = std::abs(v - median);
-  const double spread = 1.4826 * Median(logs);
+  const double spread = RobustSpread(logs, Median(logs));
   if (!(spread > 0)) return std::nullopt;
   return spread;
 }

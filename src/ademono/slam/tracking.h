@@ -203,6 +203,8 @@ class Tracking {
   bool Triangulated(const MapPoint& point) const ADEMONO_REQUIRES(map_.mutex);
   // Multiplies every length of the map and of the tracker's state by `factor`.
   void RescaleWorld(Frame& frame, double factor) ADEMONO_REQUIRES(map_.mutex);
+  // No motion to predict from (a new map, a loss): the velocity and the recent good frames go.
+  void ForgetMotion();
 
   Map& map_;
   const LocalMapping& local_mapping_;
@@ -211,8 +213,6 @@ class Tracking {
   uint64_t next_frame_id_ = 0;
   uint64_t loop_corrections_seen_ = 0;
   std::optional<Frame> last_frame_;
-  // No motion to predict from (a new map, a loss): the velocity and the recent good frames go.
-  void ForgetMotion();
   // The last good frames' (id, cam_from_world), oldest first, for MeanRecentVelocity.
   std::deque<std::pair<uint64_t, Rigid3d>> recent_good_;
   std::optional<Rigid3d> velocity_;        // current_from_last
