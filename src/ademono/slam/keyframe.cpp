@@ -91,4 +91,17 @@ std::vector<KeyFrame*> KeyFrame::BestCovisibles(size_t n) const {
   return result;
 }
 
+void AppendGroundDistances(const KeyFrame& keyframe, size_t camera,
+                           const std::map<uint64_t, size_t>& point_index,
+                           std::vector<BaPlaneDistance>& distances) {
+  if (!keyframe.ground) return;
+  const KeyFrame::Ground& ground = *keyframe.ground;
+  for (uint64_t id : ground.point_ids) {
+    const auto it = point_index.find(id);
+    if (it == point_index.end()) continue;
+    distances.push_back({camera, it->second, ground.normal_cam, -ground.height,
+                         1.0 / ground.sigma, ground.free_normal ? 0 : -1});
+  }
+}
+
 }  // namespace ademono

@@ -9,6 +9,7 @@
 #include <set>
 #include <vector>
 
+#include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/network_depth_model.h"
 #include "ademono/slam/frame.h"
 #include "ademono/slam/map_point.h"
@@ -73,5 +74,12 @@ class KeyFrame {
   void EraseConnection(KeyFrame* other);
   void SortConnections();
 };
+
+// depth.ground_in_ba: the keyframe's road points that a bundle adjustment solves (`point_index`:
+// map point id -> the problem's point) held at its ground's height below it, as the problem's
+// camera `camera`. Local BA and the global BA after a loop hold the same road.
+void AppendGroundDistances(const KeyFrame& keyframe, size_t camera,
+                           const std::map<uint64_t, size_t>& point_index,
+                           std::vector<BaPlaneDistance>& distances);
 
 }  // namespace ademono

@@ -457,17 +457,8 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       }
     }
     // Each keyframe's road points at the rig's height below it (depth.ground_in_ba).
-    for (size_t c = 0; any_ground && c < cameras.size(); ++c) {  // in camera order: deterministic
-      const KeyFrame& kf = *cameras[c];
-      if (!kf.ground) continue;
-      for (uint64_t id : kf.ground->point_ids) {
-        const auto it = point_index_of.find(id);
-        if (it == point_index_of.end()) continue;
-        problem.plane_distances.push_back({c, it->second, kf.ground->normal_cam,
-                                           -kf.ground->height, 1.0 / kf.ground->sigma,
-                                           kf.ground->free_normal ? 0 : -1});
-      }
-    }
+    for (size_t c = 0; any_ground && c < cameras.size(); ++c)  // in camera order: deterministic
+      AppendGroundDistances(*cameras[c], c, point_index_of, problem.plane_distances);
   }
   for (const auto& c : cameras) {
     if (!c) return false;  // not in the map (cannot happen: gathered under the lock)

@@ -369,6 +369,8 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
     problem.cameras.push_back({kf->cam_from_world, problem.cameras.empty()});
     job->keyframes.push_back(kf);
   }
+  // Map point id -> problem index, for the road's residuals below (depth.ground_in_ba).
+  std::map<uint64_t, size_t> point_index_of;
   for (const auto& [id, p] : map_.MapPoints()) {
     if (p->bad) continue;
     const size_t point_index = problem.points.size();
@@ -380,9 +382,14 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
       ++observed;
     }
     if (observed == 0) continue;
+    point_index_of[id] = point_index;
     problem.points.push_back(p->position);
     job->points.push_back(p);
   }
+  // The road local BA held each keyframe's scale with: without it, the global BA lets the
+  // scale drift back (KITTI 00 with PyDNet, docs/loops.md).
+  for (size_t c = 0; c < job->keyframes.size(); ++c)
+    AppendGroundDistances(*job->keyframes[c], c, point_index_of, problem.plane_distances);
   if (event) {
     LoopEvent& e = events_[*event];
     e.global_ba = true;
@@ -466,7 +473,8 @@ void LoopClosing::EndGlobalBundleAdjustment(bool apply, uint64_t at_keyframe) {
                  e.query_keyframe, e.global_ba_keyframes, e.global_ba_points, e.global_ba_ms,
                  at_keyframe);
   } else {
-    spdlog::info("global BA before saving the map: {} keyframes, {} points, {:.0f} ms",
+    spdlog::info("global BA of the whole map (before a save, or at the end): {} keyframes, "
+                 "{} points, {:.0f} ms",
                  job->keyframes.size(), job->points.size(), job->ms);
   }
   map_.NoteLoopCorrection();  // tracking follows its reference keyframe
