@@ -1,9 +1,9 @@
 // Soak: a long synthetic office run straight from synth's renderer into slam::System (no images
 // on disk), the camera going back and forth along the office's path so the map saturates
 // (issue 16 part 3). Reports, per 1000-frame window, the tracking fps (wall time in TrackFrame,
-// and frames per CPU second of the whole process, which other load on the machine cannot lower), the resident memory and
-// the map's size; and peak RSS at 1k, 5k and 10k frames as benchmark counters. Peak RSS is per
-// process: run one variant per process (tools/soak.sh does).
+// and frames per CPU second of the whole process, which other load on the machine cannot lower),
+// the resident memory and the map's size; and peak RSS at 1k, 5k and 10k frames as benchmark
+// counters. Peak RSS is per process: run one variant per process (tools/soak.sh does).
 //
 //   build/release/bench/bench_soak                      # 10,000 frames, three variants
 //   ADEMONO_SOAK_FRAMES=3000 build/release/bench/bench_soak --benchmark_filter=Soak/Plain/

@@ -76,7 +76,12 @@ void BM_TrackingStep(benchmark::State& state) { Run(state, true, state.range(0) 
 void BM_FrameNoDepthNoDetection(benchmark::State& state) { Run(state, false); }
 
 // One iteration per frame of the slice: the reported time is the mean per frame.
-BENCHMARK(BM_TrackingStep)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(kFrames);
+BENCHMARK(BM_TrackingStep)
+    ->Arg(0)
+    ->Arg(1)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(kFrames);
 BENCHMARK(BM_FrameNoDepthNoDetection)->Unit(benchmark::kMillisecond)->Iterations(kFrames);
 
 }  // namespace

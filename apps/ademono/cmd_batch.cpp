@@ -1,6 +1,7 @@
 // `ademono batch`: a plan of datasets x variants x seeds run as `ademono infer` / `ademono run`
 // command lines by a local process pool or as Slurm job arrays, then one table and one comparison
-// report (`--collect DIR` for a Slurm job that outlived the shell). The work is in src/ademono/batch.
+// report (`--collect DIR` for a Slurm job that outlived the shell). The work is in
+// src/ademono/batch.
 #include <atomic>
 #include <csignal>
 #include <iostream>
@@ -98,7 +99,8 @@ int RunBatch(const BatchArgs& args) {
   const batch::Plan plan = batch::LoadPlan(args.plan, args.root);
   const bool slurm = args.engine == "slurm";
   if (!slurm && args.engine != "local") {
-    ThrowInputError(args.plan, "engine '" + args.engine + "' is not there (expected local or slurm)");
+    ThrowInputError(args.plan,
+                    "engine '" + args.engine + "' is not there (expected local or slurm)");
   }
   if (slurm) {
     for (const char* program : {"sbatch", "squeue"}) {

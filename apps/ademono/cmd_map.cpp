@@ -26,7 +26,8 @@ int Run(const MapArgs& args) {
 const bool kRegistered = RegisterCommand(
     "map", "Inspect a saved map (`map info FILE`)", [](CLI::App& app) -> Runner {
       auto args = std::make_shared<MapArgs>();
-      args->info = app.add_subcommand("info", "print the version, camera, sizes and options of a map");
+      args->info =
+          app.add_subcommand("info", "print the version, camera, sizes and options of a map");
       args->info->add_option("file", args->file, "map file (ademono run --save-map)")->required();
       app.require_subcommand(1);
       return [args] { return Run(*args); };

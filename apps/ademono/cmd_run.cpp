@@ -95,7 +95,8 @@ class LiveTrajectory {
  public:
   explicit LiveTrajectory(const fs::path& path) : path_(path) {
     fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) ThrowInputError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+    if (fd_ < 0)
+      ThrowInputError(path, std::string("cannot open for writing: ") + std::strerror(errno));
     Append(kTumHeader);
   }
   ~LiveTrajectory() { ::close(fd_); }

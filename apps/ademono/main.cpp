@@ -8,7 +8,8 @@
 #include "command.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"ademono: monocular SLAM with metric depth, dynamic-object and distant-point filtering"};
+  CLI::App app{
+      "ademono: monocular SLAM with metric depth, dynamic-object and distant-point filtering"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "ademono 0.1.0");
   std::string log_level = "info";

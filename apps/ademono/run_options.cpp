@@ -125,7 +125,8 @@ fs::path ResolveConfigPath(const std::string& config_arg, const Sequence& sequen
   std::string why = choice.why;
   if (depth.network || depth.none) {
     // The monocular core's two families, with a network or without depth.
-    const bool outdoor = depth.domain == "outdoor" || (depth.domain.empty() && sequence.Kind() == "kitti");
+    const bool outdoor =
+        depth.domain == "outdoor" || (depth.domain.empty() && sequence.Kind() == "kitti");
     name = outdoor ? "network_outdoor.yaml" : "network_indoor.yaml";
     why = std::string(depth.none ? "no depth (monocular), " : "depth from a network, ") +
           (outdoor ? "outdoor" : "indoor");

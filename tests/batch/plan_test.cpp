@@ -68,16 +68,17 @@ class PlanTest : public ::testing::Test {
 fs::path PlanTest::dir_;
 
 TEST_F(PlanTest, ReadsDatasetsVariantsSeedsAndSlurm) {
-  const fs::path file = Write("plan.yaml", Root() +
-                                               "datasets:\n"
-                                               "  office: tum:office\n"
-                                               "  part: {dataset: tum:office, frames: '2:10'}\n"
-                                               "variants:\n"
-                                               "  full:\n"
-                                               "  no_distant: {ablation: no_distant, set: [orb.num_features=800]}\n"
-                                               "  sim: {depth: simulated, set: {depth.max_depth: 6}}\n"
-                                               "seeds: [1, 2]\n"
-                                               "slurm: {partition: debug, time: '00:10:00', mem: 2G, cpus_per_task: 2}\n");
+  const fs::path file = Write(
+      "plan.yaml", Root() +
+                       "datasets:\n"
+                       "  office: tum:office\n"
+                       "  part: {dataset: tum:office, frames: '2:10'}\n"
+                       "variants:\n"
+                       "  full:\n"
+                       "  no_distant: {ablation: no_distant, set: [orb.num_features=800]}\n"
+                       "  sim: {depth: simulated, set: {depth.max_depth: 6}}\n"
+                       "seeds: [1, 2]\n"
+                       "slurm: {partition: debug, time: '00:10:00', mem: 2G, cpus_per_task: 2}\n");
   const Plan plan = LoadPlan(file);
   EXPECT_EQ(plan.name, "plan");
   ASSERT_EQ(plan.datasets.size(), 2u);
@@ -131,9 +132,15 @@ TEST_F(PlanTest, ExpandsIntoStableCommandLinesWithOneCachePerDatasetAndNetwork) 
   const fs::path file = Write("plan.yaml", Root() +
                                                "datasets: {office: tum:office}\n"
                                                "variants:\n"
-                                               "  full: {" + detector + "}\n"
-                                               "  no_distant: {ablation: no_distant, " + detector + "}\n"
-                                               "  geometry_only: {ablation: geometry_only, " + detector + "}\n"
+                                               "  full: {" +
+                                               detector +
+                                               "}\n"
+                                               "  no_distant: {ablation: no_distant, " +
+                                               detector +
+                                               "}\n"
+                                               "  geometry_only: {ablation: geometry_only, " +
+                                               detector +
+                                               "}\n"
                                                "seeds: [4, 5]\n");
   const Batch b = ExpandPlan(LoadPlan(file), dir_ / "out", "/bin/ademono");
   ASSERT_EQ(b.caches.size(), 1u);  // one network on one dataset, shared
@@ -183,7 +190,8 @@ TEST_F(PlanTest, SlurmScriptRunsTaskIOfTheArrayWithItsLog) {
   a.argv = {"/bin/ademono", "run", "--out", "/o/runs/x__full__s1"};
   a.log = "/o/logs/x__full__s1.log";
   b.id = "x__full__s2";
-  b.argv = {"/bin/ademono", "run", "--set", "depth.max_depth=6 ; rm", "--out", "/o/runs/x__full__s2"};
+  b.argv = {"/bin/ademono",           "run",   "--set",
+            "depth.max_depth=6 ; rm", "--out", "/o/runs/x__full__s2"};
   b.log = "/o/logs/x__full__s2.log";
   SlurmSettings s;
   s.partition = "gpu";
@@ -197,9 +205,10 @@ TEST_F(PlanTest, SlurmScriptRunsTaskIOfTheArrayWithItsLog) {
   EXPECT_THAT(script, HasSubstr("#SBATCH --time=01:00:00\n"));
   EXPECT_THAT(script, HasSubstr("#SBATCH --mem=4G\n"));
   EXPECT_THAT(script, HasSubstr("#SBATCH --cpus-per-task=2\n"));
-  EXPECT_THAT(script,
-              HasSubstr("  0)  # x__full__s1\n    mkdir -p /o/logs\n    exec /bin/ademono run --out "
-                        "/o/runs/x__full__s1 >/o/logs/x__full__s1.log 2>&1 ;;\n"));
+  EXPECT_THAT(
+      script,
+      HasSubstr("  0)  # x__full__s1\n    mkdir -p /o/logs\n    exec /bin/ademono run --out "
+                "/o/runs/x__full__s1 >/o/logs/x__full__s1.log 2>&1 ;;\n"));
   // A word with shell syntax stays one quoted word.
   EXPECT_THAT(script, HasSubstr("--set 'depth.max_depth=6 ; rm' --out"));
 }

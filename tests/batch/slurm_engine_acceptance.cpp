@@ -90,8 +90,9 @@ class SlurmBatchTest : public ::testing::Test {
     const char* seeds[] = {"3", "5"};
     for (int i = 0; i < 2; ++i) {
       const std::string name = i == 0 ? "a" : "b";
-      const Result r = Ademono(std::string("synth --scene office --motion xyz --frames 50 --seed ") +
-                               seeds[i] + " --out " + (dir_ / "data" / name).string());
+      const Result r =
+          Ademono(std::string("synth --scene office --motion xyz --frames 50 --seed ") + seeds[i] +
+                  " --out " + (dir_ / "data" / name).string());
       ASSERT_EQ(r.code, 0) << r.out;
     }
   }
@@ -168,7 +169,8 @@ TEST_F(SlurmBatchTest, SameOutputsAsLocalAndOnlyTheCancelledTaskRunsAgain) {
   EXPECT_THAT(collected.out, HasSubstr("7/8 runs done"));
 
   // Again: the cancelled task alone, in a third submission.
-  const Result again = Ademono("batch " + plan.string() + " --out " + slurm.string() + " --engine slurm");
+  const Result again =
+      Ademono("batch " + plan.string() + " --out " + slurm.string() + " --engine slurm");
   ASSERT_EQ(again.code, 0) << again.out;
   EXPECT_THAT(again.out, HasSubstr("7 done, 0 held by Slurm, 1 to run, 0 caches to compute"));
   const nlohmann::json all = nlohmann::json::parse(ReadFile(slurm / "slurm" / "submissions.json"));

@@ -38,8 +38,9 @@ class BatchCliTest : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "data");
     for (const char* name : {"a", "b"}) {
-      const CliRun r = Run(std::string("synth --scene office --motion xyz --frames 30 --seed ") +
-                           (name[0] == 'a' ? "3" : "5") + " --out " + (dir_ / "data" / name).string());
+      const CliRun r =
+          Run(std::string("synth --scene office --motion xyz --frames 30 --seed ") +
+              (name[0] == 'a' ? "3" : "5") + " --out " + (dir_ / "data" / name).string());
       ASSERT_EQ(r.exit_code, 0) << r.err;
     }
   }
@@ -61,13 +62,17 @@ fs::path BatchCliTest::dir_;
 
 TEST_F(BatchCliTest, LocalEngineRunsThePlanOnceAndAgainOnlyWhatIsMissing) {
   if (!fs::exists(kModel)) GTEST_SKIP() << "no shared data";
-  const fs::path plan = Plan("plan.yaml",
-                             "datasets: {a: tum:a, b: tum:b}\n"
-                             "variants:\n"
-                             "  full: {depth: simulated, detector: model:" + kModel.string() + "}\n"
-                             "  no_distant: {ablation: no_distant, depth: simulated, detector: model:" +
-                                 kModel.string() + "}\n"
-                             "seeds: [1]\n");
+  const fs::path plan =
+      Plan("plan.yaml",
+           "datasets: {a: tum:a, b: tum:b}\n"
+           "variants:\n"
+           "  full: {depth: simulated, detector: model:" +
+               kModel.string() +
+               "}\n"
+               "  no_distant: {ablation: no_distant, depth: simulated, detector: model:" +
+               kModel.string() +
+               "}\n"
+               "seeds: [1]\n");
   const fs::path out = dir_ / "out";
   const CliRun first = Run("batch " + plan.string() + " --out " + out.string() + " --jobs 2");
   ASSERT_EQ(first.exit_code, 0) << first.out << first.err;

@@ -18,7 +18,9 @@ using ademono::cli_test::RunCli;
 
 namespace {
 
-std::string Dataset() { return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a"; }
+std::string Dataset() {
+  return std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a";
+}
 std::string Config() { return std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml"; }
 
 std::string Bytes(const fs::path& path) {
@@ -29,7 +31,8 @@ std::string Bytes(const fs::path& path) {
 class MapCliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() / ("ademono_map_cli_" + std::to_string(::getpid())));
+    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() /
+                                      ("ademono_map_cli_" + std::to_string(::getpid())));
     fs::remove_all(*dir_);
     fs::create_directories(*dir_);
     const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
@@ -102,7 +105,8 @@ TEST_F(MapCliTest, BadMapsExitTwoWithOneLineNamingTheFile) {
     EXPECT_NE(r.out.find(c.needle), std::string::npos) << c.name << ": " << r.out;
     // One error line (the config lookup also logs an [info] line).
     size_t errors = 0;
-    for (size_t at = r.out.find("error:"); at != std::string::npos; at = r.out.find("error:", at + 1))
+    for (size_t at = r.out.find("error:"); at != std::string::npos;
+         at = r.out.find("error:", at + 1))
       ++errors;
     EXPECT_EQ(errors, 1u) << c.name << ": " << r.out;
     EXPECT_FALSE(fs::exists(out)) << c.name << ": partial output";

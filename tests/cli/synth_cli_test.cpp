@@ -27,7 +27,8 @@ class SynthCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = ademono::cli_test::FreshTempDir(
-        std::string("synth_cli_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        std::string("synth_cli_") +
+        ::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   void TearDown() override {
     std::error_code ec;

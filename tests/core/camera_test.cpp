@@ -45,7 +45,8 @@ TEST(Camera, UndistortInvertsDistort) {
 }
 
 TEST(Camera, LoadYamlAndMissingField) {
-  const auto dir = std::filesystem::temp_directory_path() / ("ademono_camera_test_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("ademono_camera_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto good = dir / "good.yaml";
   std::ofstream(good) << "camera:\n  width: 640\n  height: 480\n  fx: 500\n  fy: 501\n  cx: 320\n"

@@ -36,7 +36,8 @@ TEST(FileUtil, SplitFields) {
 }
 
 TEST(FileUtil, AtomicWriteLeavesNothingOnFailure) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_atomic_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_atomic_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const fs::path target = dir / "out.txt";
   EXPECT_THROW(WriteFileAtomic(target,
@@ -52,7 +53,8 @@ TEST(FileUtil, AtomicWriteLeavesNothingOnFailure) {
 }
 
 TEST(FileUtil, ReadImageNamesTheFile) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_image_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_image_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path bad = dir / "broken.png";
   std::ofstream(bad) << "not a png";

@@ -22,8 +22,9 @@ TEST(Geometry, MakeRigidFromMatrixOrthonormalises) {
 }
 
 TEST(Geometry, NamingConvention) {
-  const Rigid3d world_from_cam = MakeRigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
-                                             Eigen::Vector3d(1, 0, 0));
+  const Rigid3d world_from_cam =
+      MakeRigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
+                  Eigen::Vector3d(1, 0, 0));
   const Rigid3d cam_from_world = world_from_cam.inverse();
   const Eigen::Vector3d p_world(1, 1, 0);
   EXPECT_NEAR((cam_from_world * p_world - Eigen::Vector3d(1, 0, 0)).norm(), 0, 1e-12);

@@ -101,7 +101,8 @@ TEST(ModelSpecTest, DisparityAsAFractionOfTheWidth) {
   // d = 0.02 (a far point): five times as far.
   EXPECT_NEAR(spec.ToDepth(0.02, 1.0, 718.856 / 1241.0), 15.639896857373086, 1e-12);
   // The same camera at half resolution (fx and W both halved) reads the same depth.
-  EXPECT_DOUBLE_EQ(spec.ToDepth(0.1, 1.0, 359.428 / 620.5), spec.ToDepth(0.1, 1.0, 718.856 / 1241.0));
+  EXPECT_DOUBLE_EQ(spec.ToDepth(0.1, 1.0, 359.428 / 620.5),
+                   spec.ToDepth(0.1, 1.0, 718.856 / 1241.0));
   EXPECT_EQ(spec.ToDepth(0.0, 1.0, 0.5), 0.0);
   EXPECT_EQ(spec.ToDepth(-0.1, 1.0, 0.5), 0.0);
   EXPECT_EQ(spec.ToDepth(0.1, 1.0, 0.0), 0.0);  // no camera: no depth

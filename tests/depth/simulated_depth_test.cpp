@@ -173,7 +173,8 @@ TEST(SimulatedDepth, FactorySpecAndErrors) {
 }
 
 TEST(SimulatedDepth, GroundTruthFromCacheFolder) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_simulated_gt_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_simulated_gt_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   cv::imwrite((dir / "0.100000.tiff").string(), Constant(40.0));

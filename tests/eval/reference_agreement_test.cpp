@@ -149,8 +149,9 @@ TEST(KittiOdomEvalAgreementTest, EvalApeIsKittiAteInEveryAlignmentAndEstimateFra
   for (const char* seq : {"09", "10"}) {
     TrajectoryFile gt, published;
     gt.path = seq + std::string("/gt");
-    gt.poses = ReadPoseSeries(kTrajectories / "kitti-odom-eval" / "gt" / (seq + std::string(".txt")),
-                              TrajectoryFormat::kKitti);
+    gt.poses =
+        ReadPoseSeries(kTrajectories / "kitti-odom-eval" / "gt" / (seq + std::string(".txt")),
+                       TrajectoryFormat::kKitti);
     published.path = seq + std::string("/est");
     published.poses = ReadPoseSeries(
         kTrajectories / "kitti-odom-eval" / "example_1" / (seq + std::string(".txt")),

@@ -185,7 +185,8 @@ TEST(GroundPlaneTest, TwoViewsOfTheRoadGiveItsHeightInThePosesUnits) {
   Rigid3d a_from_level = Rigid3d::Identity();
   a_from_level.linear() = PitchRoll(1.0, 0.5);
   Rigid3d b_from_a = Rigid3d::Identity();
-  b_from_a.linear() = Eigen::AngleAxisd(1.0 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  b_from_a.linear() =
+      Eigen::AngleAxisd(1.0 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
   b_from_a.translation() = Eigen::Vector3d(0.02, 0.0, -1.4);
   const cv::Mat a = RenderRoad(camera, 1.65, a_from_level);
   const cv::Mat b = RenderRoad(camera, 1.65, b_from_a * a_from_level);

@@ -10,7 +10,8 @@ namespace {
 Rigid3d Pose(const Eigen::Vector3d& axis_angle, const Eigen::Vector3d& translation) {
   Rigid3d pose = Rigid3d::Identity();
   if (axis_angle.norm() > 0) {
-    pose.linear() = Eigen::AngleAxisd(axis_angle.norm(), axis_angle.normalized()).toRotationMatrix();
+    pose.linear() =
+        Eigen::AngleAxisd(axis_angle.norm(), axis_angle.normalized()).toRotationMatrix();
   }
   pose.translation() = translation;
   return pose;

@@ -91,25 +91,26 @@ void WriteRunFolder(const fs::path& dir, const FixtureOptions& o = {}) {
            {"tracking", 10.0 + (i % 3)}, {"mapping", 5.0}}},
          {"depth_scale", 1.0 + 0.01 * i}});
   }
-  json summary = {{"schema", "ademono.run/1"},
-                  {"dataset", o.dataset},
-                  {"config", "configs/tum.yaml"},
-                  {"depth", "simulated"},
-                  {"detector", "cache"},
-                  {"seed", 1},
-                  {"deterministic", true},
-                  {"filters", {{"enhancement", true}, {"dynamic_removal", true}, {"distant", true}}},
-                  {"frames", kFrames},
-                  {"tracked", kFrames - 2},
-                  {"untracked", 2},
-                  {"lost", 2},
-                  {"keyframes", kfs.size()},
-                  {"map_points", 1000},
-                  {"wall_seconds", 2.0},
-                  {"fps", 20.0},
-                  {"timing", json::object()},
-                  {"filter_counts", {{"kept", 300 * kFrames}}},
-                  {"per_frame", per_frame}};
+  json summary = {
+      {"schema", "ademono.run/1"},
+      {"dataset", o.dataset},
+      {"config", "configs/tum.yaml"},
+      {"depth", "simulated"},
+      {"detector", "cache"},
+      {"seed", 1},
+      {"deterministic", true},
+      {"filters", {{"enhancement", true}, {"dynamic_removal", true}, {"distant", true}}},
+      {"frames", kFrames},
+      {"tracked", kFrames - 2},
+      {"untracked", 2},
+      {"lost", 2},
+      {"keyframes", kfs.size()},
+      {"map_points", 1000},
+      {"wall_seconds", 2.0},
+      {"fps", 20.0},
+      {"timing", json::object()},
+      {"filter_counts", {{"kept", 300 * kFrames}}},
+      {"per_frame", per_frame}};
   WriteTextFileAtomic(dir / "summary.json", summary.dump(1));
   WriteTumTrajectory(dir / "trajectory.tum", est);
   WriteTumTrajectory(dir / "keyframes.tum", kfs);
@@ -364,13 +365,15 @@ TEST_F(ReportTest, BadInputNamesTheFile) {
   WriteTextFileAtomic(run / "summary.json", summary.dump());
   expect_error("per_frame: 'depth' is missing in some frames");
   WriteRunFolder(run);
-  WriteTextFileAtomic(run / "map.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
-                                       "property float y\nproperty float z\nend_header\n1 2 3\n4 5\n");
+  WriteTextFileAtomic(run / "map.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                      "property float y\nproperty float z\nend_header\n1 2 3\n4 5\n");
   expect_error("map.ply: vertex 1 is truncated or not a number");
 }
 
 TEST(ReadPlyPointsTest, ReadsBinaryLittleEndian) {
-  const fs::path path = fs::temp_directory_path() / ("ademono_ply_" + std::to_string(::getpid()) + ".ply");
+  const fs::path path =
+      fs::temp_directory_path() / ("ademono_ply_" + std::to_string(::getpid()) + ".ply");
   {
     std::ofstream out(path, std::ios::binary);
     out << "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
@@ -393,7 +396,8 @@ TEST(ReadPlyPointsTest, ReadsBinaryLittleEndian) {
 }
 
 TEST(ReportOptionsTest, FromYamlIsStrict) {
-  const ReportOptions o = ReportOptions::FromYaml(YAML::Load("{alignment: sim3, max_map_points: 5}"));
+  const ReportOptions o =
+      ReportOptions::FromYaml(YAML::Load("{alignment: sim3, max_map_points: 5}"));
   EXPECT_EQ(o.alignment, Alignment::kSim3);
   EXPECT_EQ(o.max_map_points, 5);
   EXPECT_THROW(ReportOptions::FromYaml(YAML::Load("{max_points: 5}")), std::invalid_argument);

@@ -94,7 +94,8 @@ TEST(AblationTest, VariantsWriteRunOutputsAndTables) {
 
   const std::string md = AblationMarkdown(results);
   EXPECT_NE(
-      md.find("| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked |"),
+      md.find(
+          "| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked |"),
       std::string::npos);
   EXPECT_NE(md.find("| full | on | on | on | on | on |"), std::string::npos);
   EXPECT_NE(md.find("| no_dynamic | on | off | on | off | on |"), std::string::npos);

@@ -93,8 +93,8 @@ TEST(SyntheticTruthTest, ScoresLabelsAgainstTheMaskAndTheStaticPersonBox) {
   // A corner just outside the mover's outline (x = 51, 2 px from its last pixel) is static but
   // at the mover's edge; 3 px away it is not.
   TruthCounts edge;
-  truth.Score(frame, {}, {{51, 50, 7}, {53, 50, 7}}, {PointLabel::kDynamicStage1, PointLabel::kKept},
-              &edge);
+  truth.Score(frame, {}, {{51, 50, 7}, {53, 50, 7}},
+              {PointLabel::kDynamicStage1, PointLabel::kKept}, &edge);
   EXPECT_EQ(edge.static_keypoints, 2);
   EXPECT_EQ(edge.static_at_mover_edge_keypoints, 1);
   EXPECT_EQ(edge.static_at_mover_edge_removed, 1);

@@ -79,7 +79,8 @@ TEST(ConfigsTest, ResolvedOptionsRoundTripForEveryShippedConfig) {
 }
 
 TEST(ConfigsTest, WriteResolvedConfigWritesTheFileAtomically) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_resolved_config_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_resolved_config_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const fs::path path = dir / "config.resolved.yaml";
   DetectorOptions detector;

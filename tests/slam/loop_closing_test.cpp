@@ -32,7 +32,8 @@ SystemOptions NetworkOptions(bool loop) {
 LoopRun RunScene(const synth::SceneOptions& scene_options, const SystemOptions& options,
             uint64_t depth_seed) {
   const synth::Scene scene = synth::BuildScene(scene_options);
-  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(200, depth_seed), nullptr);
+  const SimulatedDepthProvider network(testing_util::FastDepthLikeNetwork(200, depth_seed),
+                                       nullptr);
   LoopRun run;
   System system(scene.camera, options);
   testing_util::SyntheticRun tracked =

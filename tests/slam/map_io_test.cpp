@@ -51,7 +51,8 @@ class MapIoTest : public ::testing::Test {
  protected:
   // One map of 7-Scenes frames 0-59, built once for the whole suite.
   static void SetUpTestSuite() {
-    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() / ("ademono_map_io_" + std::to_string(::getpid())));
+    dir_ = std::make_unique<fs::path>(fs::temp_directory_path() /
+                                      ("ademono_map_io_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
     const auto sequence = Slice(0, 60);
     System system(sequence->GetCamera(), TestOptions());

@@ -260,8 +260,9 @@ TEST(StaticProbabilityTest, NewPointsOfMoversAreNeverAdmitted) {
       for (const auto& [k, point] : r.created_points) {
         EXPECT_LT(k, r.keypoints.size());
         if (k >= r.keypoints.size()) continue;
-        const cv::Point px(std::clamp(static_cast<int>(std::lround(r.keypoints[k].pt.x)), 0, moving.cols - 1),
-                           std::clamp(static_cast<int>(std::lround(r.keypoints[k].pt.y)), 0, moving.rows - 1));
+        const cv::Point px(
+            std::clamp(static_cast<int>(std::lround(r.keypoints[k].pt.x)), 0, moving.cols - 1),
+            std::clamp(static_cast<int>(std::lround(r.keypoints[k].pt.y)), 0, moving.rows - 1));
         const bool is_moving = moving.at<uint8_t>(px) > 127;
         // Created below the threshold: not admitted yet (with the test on) unless the frame
         // before confirmed it.
@@ -294,7 +295,9 @@ TEST(StaticProbabilityTest, NewPointsOfMoversAreNeverAdmitted) {
   // box, several walking along the line of sight), 358 of 854 static ones (42 %; the rest are
   // not seen again in 40 frames or not decisively). On the photo office with YOLOX-nano: 4 % and
   // 55 % (docs/ablation.md).
-  auto rate = [](long long a, long long b) { return static_cast<double>(a) / static_cast<double>(b); };
+  auto rate = [](long long a, long long b) {
+    return static_cast<double>(a) / static_cast<double>(b);
+  };
   EXPECT_EQ(on[4] + on[5], 0);
   EXPECT_LT(rate(on[1], on[0]), 0.3);
   EXPECT_GT(rate(on[3], on[2]), 0.3);

@@ -28,7 +28,8 @@ bool Magenta(const cv::Vec3b& c) { return c[0] > 200 && c[1] < 60 && c[2] > 200;
 // A photo folder: one picture with a magenta person (ellipse body, round head), a blue car and a
 // yellow bus on a green background, and its expected_detections.json.
 fs::path MakePhotoFolder(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ademono_photos_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("ademono_photos_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   cv::Mat image(400, 700, CV_8UC3, cv::Scalar(0, 160, 0));
@@ -146,7 +147,8 @@ TEST(PhotoActors, CutOutsFollowTheFigureAndBadFoldersFail) {
 
 TEST(PhotoActors, OfficeWithPhotosIsDeterministicAndMasksMatchPixels) {
   const fs::path photos = MakePhotoFolder("office");
-  const fs::path root = fs::temp_directory_path() / ("ademono_photo_office_" + std::to_string(::getpid()));
+  const fs::path root =
+      fs::temp_directory_path() / ("ademono_photo_office_" + std::to_string(::getpid()));
   fs::remove_all(root);
   GeneratorOptions options;
   options.scene.scene = "office";
@@ -253,7 +255,8 @@ TEST(PhotoActors, StreetHasACloseLeadCarAndABusCrossingTheIntersection) {
     const std::vector<Detection> boxes = BoxesFromObjectIds(scene, frame.object_id, 16);
     auto has_box = [&](const ObjectExtent& e, const std::string& cls) {
       for (const Detection& d : boxes)
-        if (d.class_name == cls && std::abs(d.box.x - e.umin) <= 1 && std::abs(d.box.y - e.vmin) <= 1)
+        if (d.class_name == cls && std::abs(d.box.x - e.umin) <= 1 &&
+            std::abs(d.box.y - e.vmin) <= 1)
           return true;
       return false;
     };

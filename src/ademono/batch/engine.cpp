@@ -111,7 +111,8 @@ std::vector<TaskOutcome> RunLocal(const std::vector<const Task*>& tasks, int job
     running.erase(it);
     TaskOutcome& o = outcomes[i];
     o.exit_code = ExitCode(status);
-    o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[i]).count();
+    o.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started[i]).count();
     o.complete = IsComplete(*tasks[i]);
     std::ostringstream timing;
     timing.setf(std::ios::fixed);
@@ -144,8 +145,8 @@ std::string SlurmScript(const std::string& job_name, const std::vector<const Tas
   s << "#SBATCH --array=0-" << tasks.size() - 1;
   if (settings.max_parallel > 0) s << "%" << settings.max_parallel;
   s << "\n";
-  s << "#SBATCH --output=" << (slurm_dir / (std::to_string(number) + "-" + kind + "-%a.out")).string()
-    << "\n";
+  s << "#SBATCH --output="
+    << (slurm_dir / (std::to_string(number) + "-" + kind + "-%a.out")).string() << "\n";
   if (!settings.partition.empty()) s << "#SBATCH --partition=" << settings.partition << "\n";
   if (!settings.time.empty()) s << "#SBATCH --time=" << settings.time << "\n";
   if (!settings.mem.empty()) s << "#SBATCH --mem=" << settings.mem << "\n";

@@ -79,7 +79,8 @@ std::string AbsoluteModel(const Reader& r, const std::string& spec, const std::s
     r.Fail("'" + where + "': " + e.what());
   }
   const fs::path file = Absolute(model.file);
-  if (!fs::is_regular_file(file)) r.Fail("'" + where + "': model file " + file.string() + " not found");
+  if (!fs::is_regular_file(file))
+    r.Fail("'" + where + "': model file " + file.string() + " not found");
   std::string out = "model:" + file.string();
   for (const auto& [key, value] : model.options) {
     out += "," + key + "=";
@@ -151,7 +152,8 @@ PlanVariant ReadVariant(const Reader& r, const std::string& name, const YAML::No
   r.Keys(node, where, {"config", "depth", "detector", "ablation", "set"});
   if (node["config"]) {
     v.config = Absolute(r.Scalar(node["config"], where + ".config"));
-    if (!fs::is_regular_file(v.config)) r.Fail("'" + where + ".config': " + v.config.string() + " not found");
+    if (!fs::is_regular_file(v.config))
+      r.Fail("'" + where + ".config': " + v.config.string() + " not found");
   }
   if (node["depth"]) v.depth = r.Scalar(node["depth"], where + ".depth");
   if (node["detector"]) v.detector = r.Scalar(node["detector"], where + ".detector");
@@ -194,7 +196,8 @@ PlanVariant ReadVariant(const Reader& r, const std::string& name, const YAML::No
     if (ablation == nullptr) {
       std::string names;
       for (const auto& a : AllAblationVariants()) names += (names.empty() ? "" : ", ") + a.name;
-      r.Fail("'" + where + ".ablation': unknown variant '" + v.ablation + "' (known: " + names + ")");
+      r.Fail("'" + where + ".ablation': unknown variant '" + v.ablation + "' (known: " + names +
+             ")");
     }
     overrides = AblationSetOverrides(*ablation);
   }
@@ -275,8 +278,10 @@ Plan LoadPlan(const fs::path& file, const std::string& root_override) {
     if (slurm["mem"]) s.mem = r.Scalar(slurm["mem"], "slurm.mem");
     if (slurm["account"]) s.account = r.Scalar(slurm["account"], "slurm.account");
     if (slurm["qos"]) s.qos = r.Scalar(slurm["qos"], "slurm.qos");
-    if (slurm["cpus_per_task"]) s.cpus_per_task = r.Int(slurm["cpus_per_task"], "slurm.cpus_per_task", 1);
-    if (slurm["max_parallel"]) s.max_parallel = r.Int(slurm["max_parallel"], "slurm.max_parallel", 1);
+    if (slurm["cpus_per_task"])
+      s.cpus_per_task = r.Int(slurm["cpus_per_task"], "slurm.cpus_per_task", 1);
+    if (slurm["max_parallel"])
+      s.max_parallel = r.Int(slurm["max_parallel"], "slurm.max_parallel", 1);
     if (const YAML::Node args = slurm["sbatch_args"]) {
       if (!args.IsSequence()) r.Fail("'slurm.sbatch_args' must be a list");
       for (const auto& a : args) s.sbatch_args.push_back(r.Scalar(a, "slurm.sbatch_args"));

@@ -78,8 +78,9 @@ std::vector<cv::Point2f> Camera::Undistort(const std::vector<cv::Point2f>& px) c
   if (!HasDistortion() || px.empty()) return px;
   std::vector<cv::Point2f> out;
   // OpenCV's default 5 iterations leave ~0.1 px error at the corners of strongly distorted lenses.
-  cv::undistortPoints(px, out, KMat(), DistortionMat(), cv::noArray(), KMat(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
+  cv::undistortPoints(
+      px, out, KMat(), DistortionMat(), cv::noArray(), KMat(),
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
   return out;
 }
 

@@ -13,7 +13,8 @@ void ThrowInputError(const std::filesystem::path& path, size_t line, const std::
 void RequireFile(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) ThrowInputError(path, "no such file");
-  if (std::filesystem::is_directory(path, ec)) ThrowInputError(path, "is a directory, expected a file");
+  if (std::filesystem::is_directory(path, ec))
+    ThrowInputError(path, "is a directory, expected a file");
 }
 
 void RequireDirectory(const std::filesystem::path& path) {

@@ -136,8 +136,9 @@ double ParseDouble(std::string_view text, const fs::path& path, size_t line, siz
   return value;
 }
 
-void ForEachDataLine(const fs::path& path, bool commas,
-                     const std::function<void(size_t, const std::vector<std::string_view>&)>& on_line) {
+void ForEachDataLine(
+    const fs::path& path, bool commas,
+    const std::function<void(size_t, const std::vector<std::string_view>&)>& on_line) {
   RequireFile(path);
   std::ifstream in(path);
   if (!in) ThrowInputError(path, "cannot open for reading");

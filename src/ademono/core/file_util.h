@@ -28,7 +28,8 @@ void WriteImageAtomic(const std::filesystem::path& path, const cv::Mat& image);
 void SyncFile(const std::filesystem::path& path);
 void SyncDirectory(const std::filesystem::path& dir);
 
-// Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing or does not decode.
+// Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing or does not
+// decode.
 cv::Mat ReadImage(const std::filesystem::path& path, int flags);
 
 // Splits on whitespace (and commas when `commas` is true), dropping empty fields.
@@ -39,7 +40,8 @@ double ParseDouble(std::string_view text, const std::filesystem::path& path, siz
 
 // Reads `path` line by line, skipping empty lines and lines starting with '#'.
 // Calls `on_line(line_number, fields)`.
-void ForEachDataLine(const std::filesystem::path& path, bool commas,
-                     const std::function<void(size_t, const std::vector<std::string_view>&)>& on_line);
+void ForEachDataLine(
+    const std::filesystem::path& path, bool commas,
+    const std::function<void(size_t, const std::vector<std::string_view>&)>& on_line);
 
 }  // namespace ademono

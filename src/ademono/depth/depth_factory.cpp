@@ -52,8 +52,8 @@ DepthSourceInfo DescribeDepthSource(const std::string& spec) {
     const auto model = cache.options.find("model");
     if (model == cache.options.end()) return {};
     const auto spec_file = cache.options.find("spec");
-    return DescribeModelDepth(model->second +
-                              (spec_file == cache.options.end() ? "" : ",spec=" + spec_file->second));
+    return DescribeModelDepth(
+        model->second + (spec_file == cache.options.end() ? "" : ",spec=" + spec_file->second));
   }
   if (kind != "model") return {};
   return DescribeModelDepth(argument);

@@ -275,7 +275,8 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
       moving_box[b] = num_judged >= params.box_vote_min_matches &&
                       num_dynamic >= params.box_vote_ratio * static_cast<double>(num_judged);
       if (moving_box[b] && failed_depths.size() >= 3) {
-        const auto mid = failed_depths.begin() + static_cast<std::ptrdiff_t>(failed_depths.size() / 2);
+        const auto mid =
+            failed_depths.begin() + static_cast<std::ptrdiff_t>(failed_depths.size() / 2);
         std::nth_element(failed_depths.begin(), mid, failed_depths.end());
         mover_depth[b] = *mid;
       }

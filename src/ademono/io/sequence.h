@@ -46,7 +46,7 @@ class Sequence {
 // "camera:/dev/videoN" (a live camera, file_sequence.h OpenCamera).
 // `camera_yaml` overrides/supplies the camera (required for folder: and video: unless DIR holds
 // camera.yaml). Throws InputError for an unknown kind, a missing path or an empty sequence.
-std::unique_ptr<Sequence> OpenSequence(const std::string& spec,
-                                       const std::optional<std::filesystem::path>& camera_yaml = {});
+std::unique_ptr<Sequence> OpenSequence(
+    const std::string& spec, const std::optional<std::filesystem::path>& camera_yaml = {});
 
 }  // namespace ademono

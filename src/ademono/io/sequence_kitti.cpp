@@ -22,7 +22,8 @@ constexpr double kKittiCameraHeight = 1.65;
 
 // The camera of line `key` and, in `cam_from_cam0`, its offset from camera 0 (whose poses
 // poses/NN.txt gives): the rectified projection is P = K [I | t], so t = K^-1 P(:, 3).
-Camera ReadKittiCalib(const fs::path& calib, const std::string& key, Eigen::Vector3d* cam_from_cam0) {
+Camera ReadKittiCalib(const fs::path& calib, const std::string& key,
+                      Eigen::Vector3d* cam_from_cam0) {
   std::optional<Camera> camera;
   ForEachDataLine(calib, false, [&](size_t line, const std::vector<std::string_view>& f) {
     if (f.front() != key + ":") return;

@@ -37,7 +37,8 @@ const std::vector<ChannelInfo>& Channels() {
 
 const ChannelInfo& Info(Channel channel) {
   const uint32_t id = static_cast<uint32_t>(channel);
-  if (id < 1 || id > kNumChannels) throw std::out_of_range("live: no channel " + std::to_string(id));
+  if (id < 1 || id > kNumChannels)
+    throw std::out_of_range("live: no channel " + std::to_string(id));
   return Channels()[id - 1];
 }
 
@@ -206,15 +207,16 @@ std::string ImageAnnotationsJson(const LiveFrame& frame) {
     }
     if (pts.empty()) continue;
     const json color = LabelColor(static_cast<PointLabel>(l));
-    points.push_back({{"timestamp", stamp},
-                      {"type", 1},
-                      {"points", std::move(pts)},
-                      {"outline_color", color},
-                      {"outline_colors", Empty()},
-                      {"fill_color", color},
-                      {"thickness", 4.0},
-                      {"metadata", json::array({{{"key", "label"},
-                                                  {"value", PointLabelName(static_cast<PointLabel>(l))}}})}});
+    points.push_back(
+        {{"timestamp", stamp},
+         {"type", 1},
+         {"points", std::move(pts)},
+         {"outline_color", color},
+         {"outline_colors", Empty()},
+         {"fill_color", color},
+         {"thickness", 4.0},
+         {"metadata", json::array({{{"key", "label"},
+                                    {"value", PointLabelName(static_cast<PointLabel>(l))}}})}});
   }
   json texts = json::array();
   const json box_color = Color(1, 0.5, 0);
@@ -222,8 +224,9 @@ std::string ImageAnnotationsJson(const LiveFrame& frame) {
     const cv::Rect2f& b = d.box;
     points.push_back({{"timestamp", stamp},
                       {"type", 2},
-                      {"points", {Point2(b.x, b.y), Point2(b.x + b.width, b.y),
-                                  Point2(b.x + b.width, b.y + b.height), Point2(b.x, b.y + b.height)}},
+                      {"points",
+                       {Point2(b.x, b.y), Point2(b.x + b.width, b.y),
+                        Point2(b.x + b.width, b.y + b.height), Point2(b.x, b.y + b.height)}},
                       {"outline_color", box_color},
                       {"outline_colors", Empty()},
                       {"fill_color", Color(1, 0.5, 0, 0)},
@@ -253,7 +256,8 @@ std::string SceneJson(const LiveMap& map) {
   }
   json path = Entity("path", map.timestamp);
   json path_points = json::array();
-  for (const StampedPose& p : map.trajectory) path_points.push_back(Vec3(p.world_from_cam.translation()));
+  for (const StampedPose& p : map.trajectory)
+    path_points.push_back(Vec3(p.world_from_cam.translation()));
   if (path_points.size() >= 2)
     path["lines"].push_back(Line(0, 2.0, Color(0.91, 0.35, 0.05), std::move(path_points)));
   json loops = Entity("loops", map.timestamp);
@@ -270,7 +274,8 @@ std::string SceneJson(const LiveMap& map) {
 std::string FrameStatsJson(const LiveFrame& frame) {
   json labels = json::object();
   for (int l = 0; l < kNumPointLabels; ++l) labels[PointLabelName(static_cast<PointLabel>(l))] = 0;
-  for (PointLabel l : frame.labels) labels[PointLabelName(l)] = labels[PointLabelName(l)].get<int>() + 1;
+  for (PointLabel l : frame.labels)
+    labels[PointLabelName(l)] = labels[PointLabelName(l)].get<int>() + 1;
   return json{{"timestamp", Time(frame.timestamp)},
               {"frame", frame.frame},
               {"state", TrackingStateName(frame.state)},
@@ -310,7 +315,8 @@ std::string RunStatusJson(const std::string& state, double timestamp, const Live
 std::string MessageDataHeader(uint32_t subscription_id, uint64_t log_time_ns) {
   std::string header(13, '\0');
   header[0] = 0x01;
-  for (int i = 0; i < 4; ++i) header[1 + i] = static_cast<char>((subscription_id >> (8 * i)) & 0xff);
+  for (int i = 0; i < 4; ++i)
+    header[1 + i] = static_cast<char>((subscription_id >> (8 * i)) & 0xff);
   for (int i = 0; i < 8; ++i) header[5 + i] = static_cast<char>((log_time_ns >> (8 * i)) & 0xff);
   return header;
 }

@@ -51,11 +51,12 @@ std::string LivePage() {
   };
   replace("<!--STYLE-->", "<style>" + std::string(ademono::web::kUplotCss) + "\n" +
                               std::string(web::kLiveCss) + "</style>");
-  replace("<!--SCRIPTS-->",
-          "<script>/* uPlot (MIT)\n" + std::string(ademono::web::kUplotLicense) + "*/\n" +
-              std::string(ademono::web::kUplotJs) + "</script>\n<script>/* regl (MIT)\n" +
-              std::string(ademono::web::kReglLicense) + "*/\n" + std::string(ademono::web::kReglJs) +
-              "</script>\n<script>" + std::string(web::kLiveJs) + "</script>");
+  replace("<!--SCRIPTS-->", "<script>/* uPlot (MIT)\n" + std::string(ademono::web::kUplotLicense) +
+                                "*/\n" + std::string(ademono::web::kUplotJs) +
+                                "</script>\n<script>/* regl (MIT)\n" +
+                                std::string(ademono::web::kReglLicense) + "*/\n" +
+                                std::string(ademono::web::kReglJs) + "</script>\n<script>" +
+                                std::string(web::kLiveJs) + "</script>");
   return page;
 }
 
@@ -66,7 +67,8 @@ bool OffersSubprotocol(std::string_view header) {
     size_t end = header.find(',', start);
     if (end == std::string_view::npos) end = header.size();
     std::string_view token = header.substr(start, end - start);
-    while (!token.empty() && (token.front() == ' ' || token.front() == '\t')) token.remove_prefix(1);
+    while (!token.empty() && (token.front() == ' ' || token.front() == '\t'))
+      token.remove_prefix(1);
     while (!token.empty() && (token.back() == ' ' || token.back() == '\t')) token.remove_suffix(1);
     if (token == kSubprotocol) return true;
     start = end + 1;
@@ -395,9 +397,9 @@ class Session : public std::enable_shared_from_this<Session> {
       return;
     }
     if (pending_.empty()) return;
-    auto next = std::min_element(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) {
-      return a.second.seq < b.second.seq;
-    });
+    auto next =
+        std::min_element(pending_.begin(), pending_.end(),
+                         [](const auto& a, const auto& b) { return a.second.seq < b.second.seq; });
     const uint32_t channel = next->first;
     in_flight_ = std::move(next->second);
     pending_.erase(next);
@@ -569,7 +571,8 @@ void LiveServer::Impl::Drain() {
   }
   auto make = [](std::string s) { return std::make_shared<const std::string>(std::move(s)); };
   for (LiveFrame& f : frames) {
-    if (run_state != "running" && run_state != "finished") PublishStatus("running", f.timestamp, nullptr);
+    if (run_state != "running" && run_state != "finished")
+      PublishStatus("running", f.timestamp, nullptr);
     const uint64_t t = ToNanoseconds(f.timestamp);
     if (f.cam_from_world) {
       if (Subscribed(Channel::kTransform)) Publish(Channel::kTransform, make(TransformJson(f)), t);
@@ -614,7 +617,8 @@ LiveOptions ParseLiveAddress(const std::string& text) {
   std::smatch m;
   LiveOptions o;
   if (!std::regex_match(text, m, kPattern))
-    throw InputError("live address '" + text + "': expected [HOST:]PORT, e.g. 8765 or 127.0.0.1:8765");
+    throw InputError("live address '" + text +
+                     "': expected [HOST:]PORT, e.g. 8765 or 127.0.0.1:8765");
   if (m[1].matched) {
     std::string host = m[1].str();
     if (host.front() == '[') host = host.substr(1, host.size() - 2);
@@ -732,7 +736,8 @@ int64_t NowNs() {
 }  // namespace
 
 bool LiveServer::WantsMapSnapshot(bool map_changed) {
-  const bool watched = impl_->Subscribed(Channel::kMap) || impl_->Subscribed(Channel::kTrajectory) ||
+  const bool watched = impl_->Subscribed(Channel::kMap) ||
+                       impl_->Subscribed(Channel::kTrajectory) ||
                        impl_->Subscribed(Channel::kScene);
   if (!watched) return false;
   const int64_t now = NowNs();

@@ -278,7 +278,8 @@ void TwoViewGroundOptions::Check() const {
   if (iterations < 1) throw std::invalid_argument("two-view ground: iterations must be >= 1");
   if (!(huber > 0)) throw std::invalid_argument("two-view ground: huber must be > 0");
   if (min_pixels < 10) throw std::invalid_argument("two-view ground: min_pixels must be >= 10");
-  if (!(min_gradient >= 0)) throw std::invalid_argument("two-view ground: min_gradient must be >= 0");
+  if (!(min_gradient >= 0))
+    throw std::invalid_argument("two-view ground: min_gradient must be >= 0");
   if (!(min_inlier_share >= 0 && min_inlier_share <= 1))
     throw std::invalid_argument("two-view ground: min_inlier_share must be in [0, 1]");
   if (!(max_tilt_deg > 0 && max_tilt_deg < 90))

@@ -89,7 +89,8 @@ std::vector<Eigen::Vector3d> RoadCandidates(const std::vector<cv::Point2f>& keyp
 // the camera, e.g. the camera's up axis (0, -1, 0) for a level rig, or the map's road normal):
 // the median of -normal.p, with the share of points within inlier_ratio (in log) of it.
 GroundPlane GroundHeightAlong(const std::vector<Eigen::Vector3d>& points_cam,
-                              const Eigen::Vector3d& normal, const GroundPlaneOptions& options = {});
+                              const Eigen::Vector3d& normal,
+                              const GroundPlaneOptions& options = {});
 // The camera's height above the road and the road's normal (camera frame) from a frame's dense
 // depth map, with a confidence. InvalidArgument for a depth map of the wrong type or size.
 GroundPlane EstimateGroundFromDepth(const cv::Mat& depth, const Camera& camera,

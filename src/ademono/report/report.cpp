@@ -121,7 +121,8 @@ struct AlignedRun {
 AlignedRun Align(const RunFolder& run, Alignment alignment) {
   AlignedRun aligned;
   if (!run.ground_truth) {
-    aligned.note = "no ground truth in the run folder (groundtruth.tum): the estimate is drawn as is";
+    aligned.note =
+        "no ground truth in the run folder (groundtruth.tum): the estimate is drawn as is";
     return aligned;
   }
   EvalOptions eval;
@@ -227,7 +228,8 @@ json FramesJson(const RunFolder& run, double t0) {
   // Optional (runs before the geometric test lack them): -1 = not recorded, left out of the plot.
   const std::vector<std::string> optional_ints = {"static_points", "geometric_dynamic"};
   for (const auto& k : optional_ints) cols[k] = json::array();
-  cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model, 3 depth odometry
+  cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model, 3
+                                 // depth odometry
   json filter = json::object(), ms = json::object(), depth_scale = json::array();
   bool any_scale = false;
   size_t i = 0;
@@ -479,9 +481,10 @@ json ThumbnailsJson(const RunFolder& run, const json& frames, const json& traj,
 
 json SummaryJson(const RunFolder& run) {
   json s;
-  for (const char* k : {"dataset", "config", "depth", "detector", "seed", "deterministic", "filters",
-                        "frames", "tracked", "untracked", "lost", "keyframes", "map_points",
-                        "wall_seconds", "fps", "timing", "filter_counts", "accuracy"}) {
+  for (const char* k :
+       {"dataset", "config", "depth", "detector", "seed", "deterministic", "filters", "frames",
+        "tracked", "untracked", "lost", "keyframes", "map_points", "wall_seconds", "fps", "timing",
+        "filter_counts", "accuracy"}) {
     if (run.summary.contains(k)) s[k] = run.summary[k];
   }
   return s;
@@ -631,13 +634,25 @@ MapCloud ReadPlyPoints(const fs::path& path) {
         const std::string& t = props[i].first;
         char buf[8];
         const size_t size = type_size(t);
-        if (!in.read(buf, size)) ThrowInputError(path, "vertex " + std::to_string(v) + " is truncated");
-        if (t == "float" || t == "float32") { float f; std::memcpy(&f, buf, 4); values[i] = f; }
-        else if (t == "double" || t == "float64") { double d; std::memcpy(&d, buf, 8); values[i] = d; }
-        else if (t == "uchar" || t == "uint8") values[i] = static_cast<uint8_t>(buf[0]);
+        if (!in.read(buf, size))
+          ThrowInputError(path, "vertex " + std::to_string(v) + " is truncated");
+        if (t == "float" || t == "float32") { float f; std::memcpy(&f, buf, 4); values[i] = f;
+        } else if (t == "double" || t == "float64") {
+          double d;
+          std::memcpy(&d, buf, 8);
+          values[i] = d;
+        } else if (t == "uchar" || t == "uint8")
+          values[i] = static_cast<uint8_t>(buf[0]);
         else if (t == "char" || t == "int8") values[i] = static_cast<int8_t>(buf[0]);
-        else if (size == 2) { uint16_t s; std::memcpy(&s, buf, 2); values[i] = (t == "short" || t == "int16") ? static_cast<int16_t>(s) : s; }
-        else { uint32_t s; std::memcpy(&s, buf, 4); values[i] = (t == "int" || t == "int32") ? static_cast<int32_t>(s) : s; }
+        else if (size == 2) {
+          uint16_t s;
+          std::memcpy(&s, buf, 2);
+          values[i] = (t == "short" || t == "int16") ? static_cast<int16_t>(s) : s;
+        } else {
+          uint32_t s;
+          std::memcpy(&s, buf, 4);
+          values[i] = (t == "int" || t == "int32") ? static_cast<int32_t>(s) : s;
+        }
       }
     }
     const Eigen::Vector3d p(values[ix], values[iy], values[iz]);
@@ -673,7 +688,8 @@ RunFolder ReadRunFolder(const fs::path& dir) {
   if (!per_frame.is_array()) ThrowInputError(summary_path, "per_frame is not a list");
   run.trajectory = ReadTumTrajectory(dir / "trajectory.tum");
   if (fs::exists(dir / "keyframes.tum")) run.keyframes = ReadTumTrajectory(dir / "keyframes.tum");
-  if (fs::exists(dir / "groundtruth.tum")) run.ground_truth = ReadTumTrajectory(dir / "groundtruth.tum");
+  if (fs::exists(dir / "groundtruth.tum"))
+    run.ground_truth = ReadTumTrajectory(dir / "groundtruth.tum");
   if (fs::exists(dir / "map.ply")) {
     run.map = ReadPlyPoints(dir / "map.ply");
     run.has_map = true;
@@ -765,7 +781,8 @@ std::string RenderReportHtml(const json& data) {
   return html;
 }
 
-fs::path WriteRunReport(const fs::path& run_dir, const ReportOptions& options, const fs::path& out) {
+fs::path WriteRunReport(const fs::path& run_dir, const ReportOptions& options,
+                        const fs::path& out) {
   const RunFolder run = ReadRunFolder(run_dir);
   const fs::path target = out.empty() ? run_dir / "report.html" : out;
   WriteTextFileAtomic(target, RenderReportHtml(RunReportData(run, options)));

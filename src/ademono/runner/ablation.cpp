@@ -130,7 +130,8 @@ std::string AblationMarkdown(const std::vector<VariantResult>& results) {
     return s.str();
   };
   const bool truth = !results.empty() && results.front().truth.has_value();
-  os << "| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked | keyframes | "
+  os << "| variant | enh | dyn | dist | geo | boxes | ATE se3 (m) | ATE sim3 (m) | tracked | "
+        "keyframes | "
         "removed enh | removed dyn (small/st1/st2/vote) | removed distant (of >Z_th) |";
   if (truth)
     os << " moving removed | moving kept out of tracking and map | unboxed moving removed | "

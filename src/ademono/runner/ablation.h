@@ -39,8 +39,9 @@ struct AblationVariant {
 // full, no_dynamic, no_distant, no_dynamic_no_distant, no_enhancement.
 const std::vector<AblationVariant>& DefaultAblationVariants();
 // The defaults plus boxes_only (the detector's boxes through the paper's rule: small boxes dropped,
-// the two-stage test in large ones, no geometric test) and geometry_only (no detections, the geometric test alone): with a real
-// detector (`--detector model:...`) these compare what the boxes and the geometry each bring.
+// the two-stage test in large ones, no geometric test) and geometry_only (no detections, the
+// geometric test alone): with a real detector (`--detector model:...`) these compare what the boxes
+// and the geometry each bring.
 const std::vector<AblationVariant>& AllAblationVariants();
 
 // The same variant as `ademono run` options: the config overrides ("section.key=value", for

@@ -8,7 +8,8 @@ namespace fs = std::filesystem;
 
 namespace ademono {
 
-YAML::Node LoadConfigWithOverrides(const fs::path& path, const std::vector<std::string>& overrides) {
+YAML::Node LoadConfigWithOverrides(const fs::path& path,
+                                   const std::vector<std::string>& overrides) {
   YAML::Node config;
   if (!path.empty()) {
     RequireFile(path);

@@ -165,7 +165,8 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
         wait_ms = MsSince(wait_start);
       } else {
         current = Prepare(sequence, depth, detector, system, false, i);
-        inline_cpu = current.cpu_ms - current.decode_cpu_ms;  // the tracking thread: decode excluded
+        inline_cpu =
+            current.cpu_ms - current.decode_cpu_ms;  // the tracking thread: decode excluded
       }
       while (options.overlap && launched < end && launched <= i + depth_ahead) {
         ahead.push_back(std::async(std::launch::async, Prepare, std::cref(sequence), depth,

@@ -207,7 +207,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     std::map<size_t, double> scales;
     for (const auto& [index, scale] : system.DepthScales()) scales[index] = scale;
     for (FrameReport& f : report.per_frame) {
-      if (auto it = scales.find(f.frame); f.tracked && it != scales.end()) f.depth_scale = it->second;
+      if (auto it = scales.find(f.frame); f.tracked && it != scales.end())
+        f.depth_scale = it->second;
     }
   }
   report.map_cloud = system.MapPointCloud();

@@ -18,8 +18,8 @@ constexpr const char* kStagingPrefix = ".staging.";
 
 // Every file a run folder may hold, in commit order: summary.json last (the commit mark),
 // report.html is written from the committed files afterwards (cmd_run).
-constexpr const char* kOutputs[] = {"trajectory.tum", "trajectory.kitti",       "keyframes.tum",
-                                    "map.ply",        "groundtruth.tum",        "config.resolved.yaml",
+constexpr const char* kOutputs[] = {"trajectory.tum", "trajectory.kitti", "keyframes.tum",
+                                    "map.ply",        "groundtruth.tum",  "config.resolved.yaml",
                                     "summary.json"};
 
 void RenameOrThrow(const fs::path& from, const fs::path& to) {

@@ -22,7 +22,8 @@ BackEnd::BackEnd(const Camera& camera, const SystemOptions& options)
   map_.SetKeyFrameDatabase(&keyframe_database_);
   if (options_.loop.enabled) {
     loop_closing_ = std::make_unique<LoopClosing>(
-        map_, keyframe_database_, options_.loop, options_.loop.UseSim3(options_.depth.IsPrior() || options_.tracking.monocular),
+        map_, keyframe_database_, options_.loop,
+        options_.loop.UseSim3(options_.depth.IsPrior() || options_.tracking.monocular),
         options_.mapping.fuse_radius);
     local_mapping_.SetLoopClosing(loop_closing_.get());
   }
@@ -51,7 +52,9 @@ void BackEnd::Shutdown() {
 namespace {
 
 bool SameCamera(const Camera& a, const Camera& b) {
-  auto close = [](double x, double y) { return std::abs(x - y) <= 1e-6 * std::max(1.0, std::abs(x)); };
+  auto close = [](double x, double y) {
+    return std::abs(x - y) <= 1e-6 * std::max(1.0, std::abs(x));
+  };
   if (a.width != b.width || a.height != b.height) return false;
   if (!close(a.fx, b.fx) || !close(a.fy, b.fy) || !close(a.cx, b.cx) || !close(a.cy, b.cy))
     return false;

@@ -77,7 +77,8 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
   const double bf = f->intrinsics.bf;
   for (size_t i = 0; i < n; ++i) {
     if (f->depth[i] > 0) {
-      if (!monocular) f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+      if (!monocular)
+        f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
     } else {
       f->depth[i] = -1.f;
     }
@@ -124,7 +125,8 @@ std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features,
   for (size_t i = 0; i < f->Size(); ++i) {
     if (!(f->depth[i] > 0)) continue;
     f->depth[i] *= scale;
-    if (!f->monocular) f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
+    if (!f->monocular)
+      f->u_right[i] = static_cast<float>(f->keypoints_un[i].pt.x - bf / f->depth[i]);
   }
   return f;
 }

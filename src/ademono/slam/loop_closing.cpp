@@ -236,7 +236,8 @@ std::optional<LoopClosing::Verified> LoopClosing::Verify(KeyFrame& query,
     if (!v.matched[i]) continue;
     const cv::KeyPoint& kp = fq.keypoints_un[i];
     in_query.push_back({candidate.cam_from_world * v.matched[i]->position,
-                        Eigen::Vector2d(kp.pt.x, kp.pt.y), fq.pyramid->inv_level_sigma2[kp.octave]});
+                        Eigen::Vector2d(kp.pt.x, kp.pt.y),
+                        fq.pyramid->inv_level_sigma2[kp.octave]});
   }
   v.match_from_query = RefineSim3(best, fq.intrinsics, fc.intrinsics, in_candidate, in_query,
                                   !sim3_);

@@ -119,7 +119,8 @@ constexpr char kMagic[8] = {'A', 'D', 'E', 'M', 'A', 'P', '\r', '\n'};
 
 template <typename T>
 void PutLittleEndian(std::string& out, T value) {
-  for (size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<char>((value >> (8 * i)) & 0xff));
+  for (size_t i = 0; i < sizeof(T); ++i)
+    out.push_back(static_cast<char>((value >> (8 * i)) & 0xff));
 }
 
 template <typename T>
@@ -262,7 +263,8 @@ MapFileData MapToRecords(const Map& map, const Camera& camera, const SystemOptio
     r.depth_error_per_metre = f.depth_error.per_metre;
     r.weight_by_error_model = f.weight_by_error_model ? 1 : 0;
     r.depth_scale = f.depth_scale;
-    r.parent = kf->parent != nullptr && !kf->parent->bad ? static_cast<int64_t>(kf->parent->id) : -1;
+    r.parent =
+        kf->parent != nullptr && !kf->parent->bad ? static_cast<int64_t>(kf->parent->id) : -1;
     for (const auto& [other, weight] : kf->connections)
       if (!other->bad) r.connections.emplace_back(other->id, weight);
     d.keyframes.push_back(std::move(r));
@@ -464,11 +466,12 @@ void RestoreMap(const MapFileData& data, const std::shared_ptr<const ScalePyrami
     for (const auto& k : r.keypoints)
       keypoints.emplace_back(cv::Point2f(k.x, k.y), k.size, k.angle, k.response, k.octave);
     cv::Mat descriptors(static_cast<int>(r.keypoints.size()), 32, CV_8UC1);
-    if (!r.descriptors.empty()) std::memcpy(descriptors.data, r.descriptors.data(), r.descriptors.size());
-    auto built = MakeFrameFeatures(data.camera, pyramid, data.camera.fx > 0 ? r.bf / data.camera.fx : 0,
-                                   r.close_depth, std::move(keypoints), descriptors, r.depth,
-                                   {r.depth_error_relative, r.depth_error_per_metre},
-                                   r.weight_by_error_model != 0);
+    if (!r.descriptors.empty())
+      std::memcpy(descriptors.data, r.descriptors.data(), r.descriptors.size());
+    auto built = MakeFrameFeatures(
+        data.camera, pyramid, data.camera.fx > 0 ? r.bf / data.camera.fx : 0, r.close_depth,
+        std::move(keypoints), descriptors, r.depth,
+        {r.depth_error_relative, r.depth_error_per_metre}, r.weight_by_error_model != 0);
     // Exactly the saved values (bf / fx * fx may differ in the last bit).
     auto features = std::make_shared<FrameFeatures>(*built);
     features->intrinsics.bf = r.bf;

@@ -348,9 +348,9 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
   // Camera 1's centre seen from camera 2: near the epipole a depth is ill-defined (ORB-SLAM
   // skips matches there for keypoints without depth).
   const bool has_epipole = t.z() > 1e-9 * t.norm();
-  const Eigen::Vector2d epipole =
-      has_epipole ? Eigen::Vector2d(in2.fx * t.x() / t.z() + in2.cx, in2.fy * t.y() / t.z() + in2.cy)
-                  : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d epipole = has_epipole ? Eigen::Vector2d(in2.fx * t.x() / t.z() + in2.cx,
+                                                                in2.fy * t.y() / t.z() + in2.cy)
+                                              : Eigen::Vector2d::Zero();
   std::vector<int> best1_for2(f2.Size(), -1), dist_for2(f2.Size(), 256);
   for (size_t i = 0; i < f1.Size(); ++i) {
     if (k1.map_points[i] && !k1.map_points[i]->bad) continue;

@@ -39,7 +39,8 @@ StaticEvidence JudgeObservation(double residual_px, std::optional<double> depth_
   const double allowance =
       std::isfinite(residual_allowance_px) ? std::max(residual_allowance_px, 0.0) : 0.0;
   const bool depth_known = depth_relative_error && std::isfinite(*depth_relative_error);
-  const double sigma = std::isfinite(depth_relative_sigma) ? std::max(depth_relative_sigma, 0.0) : 0.0;
+  const double sigma =
+      std::isfinite(depth_relative_sigma) ? std::max(depth_relative_sigma, 0.0) : 0.0;
   const double noise =
       std::isfinite(point_relative_sigma) ? std::max(point_relative_sigma, 0.0) : 0.0;
   const double static_band = std::max(

@@ -34,7 +34,8 @@ constexpr size_t kMeanVelocityFrames = 6;
 // Matched points (map or odometry) that are not outliers.
 int CountInliers(const Frame& frame) {
   int n = 0;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) n += frame.map_points[i] && !frame.outlier[i];
+  for (size_t i = 0; i < frame.map_points.size(); ++i)
+    n += frame.map_points[i] && !frame.outlier[i];
   return n;
 }
 
@@ -792,7 +793,8 @@ bool Tracking::TrackLocalMap(Frame& frame) {
   bool map_only = false;
   if (odometry_localisation_) {
     int in_map = 0;
-    for (const auto& p : frame.map_points) in_map += p && p->NumObservations() > 0 && UsableForPose(*p);
+    for (const auto& p : frame.map_points)
+      in_map += p && p->NumObservations() > 0 && UsableForPose(*p);
     map_only = in_map >= options_.tracking.min_inliers;
   }
   auto count_inliers = [&frame] {
@@ -822,7 +824,8 @@ bool Tracking::TrackLocalMap(Frame& frame) {
       OptimizeFramePose(frame, -1, map_only);
       // Only a pose that rests on enough points judges the points (a weak one would teach the
       // map its own error).
-      if (count_inliers() >= options_.tracking.min_inliers) judged_dynamic_ = JudgeStaticness(frame);
+      if (count_inliers() >= options_.tracking.min_inliers)
+        judged_dynamic_ = JudgeStaticness(frame);
     }
     // The final optimisation reset the flags: points judged moving stay out.
     for (size_t i = 0; i < frame.map_points.size(); ++i) {
@@ -1045,7 +1048,8 @@ bool Tracking::HasTriangulationBaseline(const Frame& frame) const {
   std::vector<double> depths;
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
-    if (p && !p->bad && !frame.outlier[i]) depths.push_back((*frame.cam_from_world * p->position).z());
+    if (p && !p->bad && !frame.outlier[i])
+      depths.push_back((*frame.cam_from_world * p->position).z());
   }
   const double median_depth = Median(depths);
   if (!(median_depth > 0)) return true;

@@ -26,8 +26,8 @@ struct MotionSpec {
   Eigen::Vector3d world_up{0, 0, 1};
   double forward_speed = 0.0;           // m/s along the camera's optical axis (forward)
   // loop: an ellipse in the horizontal plane through loop_centre (radii along world x and y),
-  // counter-clockwise seen from above, the camera looking outwards (pitched down by loop_pitch_rad), one lap per loop_period_s
-  // starting at angle loop_start_rad (0 = +x).
+  // counter-clockwise seen from above, the camera looking outwards (pitched down by
+  // loop_pitch_rad), one lap per loop_period_s starting at angle loop_start_rad (0 = +x).
   Eigen::Vector3d loop_centre{0, 0, 0};
   Eigen::Vector2d loop_radii{1, 1};
   double loop_period_s = 10.0;

@@ -123,8 +123,10 @@ ActorPhotos LoadActorPhotos(const fs::path& dir) {
     (c.class_id == 0 ? photos.persons : c.class_id == 2 ? photos.cars : photos.buses)
         .push_back(std::move(cutout));
   }
-  if (photos.persons.empty()) ThrowInputError(json_path, "no person box to cut out (score >= 0.5, >= 100 px tall)");
-  if (photos.cars.empty()) ThrowInputError(json_path, "no car box to cut out (score >= 0.5, >= 60 px wide)");
+  if (photos.persons.empty())
+    ThrowInputError(json_path, "no person box to cut out (score >= 0.5, >= 100 px tall)");
+  if (photos.cars.empty())
+    ThrowInputError(json_path, "no car box to cut out (score >= 0.5, >= 60 px wide)");
   return photos;
 }
 

@@ -459,8 +459,9 @@ void BuildStreet(const SceneOptions& options, const ActorPhotos* photos, Scene& 
       scene.objects[id - 1].appearance = cutout.source;
       const double w = scene.sprites[sprite].width_m(), h = scene.sprites[sprite].height_m();
       scene.actors.back() = [=](double t, std::vector<Box>& boxes) {
-        const Eigen::Vector3d at = t < t_turn ? Eigen::Vector3d(lead_x(t), -1.75, 0)
-                                              : Eigen::Vector3d(x_turn, -1.75 - 6.0 * (t - t_turn), 0);
+        const Eigen::Vector3d at = t < t_turn
+                                       ? Eigen::Vector3d(lead_x(t), -1.75, 0)
+                                       : Eigen::Vector3d(x_turn, -1.75 - 6.0 * (t - t_turn), 0);
         AppendSprite(At(at.x(), at.y(), 0), M_PI / 2, sprite, w, h, id, boxes);
       };
     }
@@ -613,7 +614,9 @@ void BuildStreetLoop(const SceneOptions& options, Scene& scene) {
       look.tyre =
           textures.ForBox(TextureStyle::kDark, {0.93, 0.93, 0.93}, 0.01, {0.8f, 0.8f, 0.8f});
       Rigid3d pose = on_ring(arc / axis, 5.6 * side, 0);
-      if (rng.Uniform() < 0.5) pose.linear() = pose.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      if (rng.Uniform() < 0.5)
+        pose.linear() =
+            pose.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       const int id = scene.AddObject("parked-car-" + std::to_string(++parked), 2, false);
       AppendCar(pose, look, id, scene.static_boxes);
     }
