@@ -364,7 +364,8 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
   std::map<const KeyFrame*, size_t> camera_index;
   for (const auto& [id, kf] : map_.KeyFrames()) {
     if (kf->bad) continue;
-    // The oldest keyframe fixes the gauge (with network depth the depth residuals fix the scale).
+    // The oldest keyframe fixes the gauge; the scale is fixed by sensor-like depth residuals or
+    // by the road (depth.ground_in_ba), and is free in the monocular core without them.
     if (problem.cameras.empty()) problem.intrinsics = kf->F().intrinsics;
     camera_index[kf.get()] = problem.cameras.size();
     problem.cameras.push_back({kf->cam_from_world, problem.cameras.empty()});
