@@ -72,7 +72,7 @@ struct PlaneDistanceResidual {
 // Solves with the observations not flagged in `skip`; returns whether Ceres converged.
 bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
            const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
-           std::vector<double>& points, std::vector<double>& normals,
+           std::vector<double>& points, double* normals,
            const std::vector<size_t>& normal_slot) {
   ceres::Problem ceres_problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
@@ -105,7 +105,7 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
           new ceres::HuberLoss(1.0), &cameras[6 * d.camera], &points[3 * d.point]);
       continue;
     }
-    double* normal = &normals[3 * normal_slot[i]];
+    double* normal = normals + 3 * normal_slot[i];
     ceres_problem.AddResidualBlock(
         new ceres::AutoDiffCostFunction<PlaneDistanceResidual, 1, 6, 3, 3>(
             new PlaneDistanceResidual(d)),
@@ -191,28 +191,33 @@ BundleAdjustmentResult SolveBundleAdjustment(const BundleAdjustmentProblem& prob
       throw std::invalid_argument("bundle adjustment: plane distance index out of range");
     }
   }
-  std::vector<double> cameras(6 * problem.cameras.size()), points(3 * problem.points.size());
+  // One solved normal per (camera, plane), started from its first distance's; normal_slot[i] is
+  // distance i's (unused for held normals).
+  std::vector<size_t> normal_slot(problem.plane_distances.size());
+  std::map<std::pair<size_t, int>, size_t> slot_of;
+  std::vector<Eigen::Vector3d> initial_normals;
+  for (size_t i = 0; i < problem.plane_distances.size(); ++i) {
+    const BaPlaneDistance& d = problem.plane_distances[i];
+    if (d.plane < 0) continue;
+    const auto [it, inserted] = slot_of.emplace(std::make_pair(d.camera, d.plane), slot_of.size());
+    normal_slot[i] = it->second;
+    if (inserted) initial_normals.push_back(d.normal_cam.normalized());
+  }
+  // The normals live behind the cameras in one buffer: Ceres orders a group's parameter blocks by
+  // address, so two buffers would put cameras and normals in whichever order the heap gave them,
+  // and the solve's rounding would change from run to run.
+  const size_t camera_values = 6 * problem.cameras.size();
+  std::vector<double> cameras(camera_values + 3 * initial_normals.size()),
+      points(3 * problem.points.size());
   for (size_t c = 0; c < problem.cameras.size(); ++c) {
     internal::RigidToParams(problem.cameras[c].cam_from_world, &cameras[6 * c]);
   }
   for (size_t p = 0; p < problem.points.size(); ++p) {
     for (int k = 0; k < 3; ++k) points[3 * p + k] = problem.points[p][k];
   }
-
-  // One solved normal per (camera, plane), started from its first distance's; normal_slot[i] is
-  // distance i's (unused for held normals).
-  std::vector<double> normals;
-  std::vector<size_t> normal_slot(problem.plane_distances.size());
-  std::map<std::pair<size_t, int>, size_t> slot_of;
-  for (size_t i = 0; i < problem.plane_distances.size(); ++i) {
-    const BaPlaneDistance& d = problem.plane_distances[i];
-    if (d.plane < 0) continue;
-    const auto [it, inserted] = slot_of.emplace(std::make_pair(d.camera, d.plane), slot_of.size());
-    normal_slot[i] = it->second;
-    if (inserted) {
-      const Eigen::Vector3d unit = d.normal_cam.normalized();
-      normals.insert(normals.end(), unit.data(), unit.data() + 3);
-    }
+  double* normals = cameras.data() + camera_values;
+  for (size_t n = 0; n < initial_normals.size(); ++n) {
+    for (int k = 0; k < 3; ++k) normals[3 * n + k] = initial_normals[n][k];
   }
 
   BundleAdjustmentResult result;
