@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <opencv2/features2d.hpp>
 
+#include "ademono/feature/line_search_grid.h"
 #include "ademono/feature/orb_extractor.h"
 
 namespace ademono {
@@ -352,6 +353,12 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
                                                                 in2.fy * t.y() / t.z() + in2.cy)
                                               : Eigen::Vector2d::Zero();
   std::vector<int> best1_for2(f2.Size(), -1), dist_for2(f2.Size(), 256);
+  // Only keypoints near the epipolar line are tested (the widest band, the top level's).
+  const LineSearchGrid grid2(f2.keypoints_un, free2);
+  const std::vector<float>& level_sigma2 = f2.pyramid->level_sigma2;
+  const double band_radius =
+      std::sqrt(3.84 * *std::max_element(level_sigma2.begin(), level_sigma2.end()));
+  std::vector<size_t> near_line;
   for (size_t i = 0; i < f1.Size(); ++i) {
     if (k1.map_points[i] && !k1.map_points[i]->bad) continue;
     const cv::KeyPoint& kp1 = f1.keypoints_un[i];
@@ -371,10 +378,11 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
       segment = project2(cam2_from_cam1 * (z_near * ray), &seg_a) &&
                 project2(cam2_from_cam1 * (z_far * ray), &seg_b);
     }
-    const cv::Mat d1 = f1.descriptors.row(static_cast<int>(i));
+    const uchar* d1 = f1.descriptors.ptr<uchar>(static_cast<int>(i));
     int best = 256, second = 256;
     size_t best_j = 0;
-    for (size_t j : free2) {
+    grid2.Near(line, band_radius, &near_line);
+    for (size_t j : near_line) {
       const cv::KeyPoint& kp2 = f2.keypoints_un[j];
       const double e = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
       const double sigma2 = f2.pyramid->level_sigma2[kp2.octave];
@@ -391,9 +399,10 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
         const double margin = 2.0 * std::sqrt(sigma2) / std::sqrt(std::max(len2, 1e-9));
         if (s < -margin || s > 1.0 + margin) continue;
       }
-      const int d = DescriptorDistance(d1, f2.descriptors.row(static_cast<int>(j)));
+      const int d = DescriptorDistance(d1, f2.descriptors.ptr<uchar>(static_cast<int>(j)));
       if (d > kOrbDistanceLow) continue;
-      if (d < best) {
+      // Ties go to the lower index: the candidates come in no particular order.
+      if (d < best || (d == best && j < best_j)) {
         second = best;
         best = d;
         best_j = j;
