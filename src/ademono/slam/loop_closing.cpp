@@ -371,7 +371,9 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
     problem.cameras.push_back({kf->cam_from_world, problem.cameras.empty()});
     job->keyframes.push_back(kf);
   }
-  // Map point id -> problem index, for the road's residuals below (depth.ground_in_ba).
+  // Map point id -> problem index, only for the road's residuals below (depth.ground_in_ba).
+  const bool any_ground = std::any_of(job->keyframes.begin(), job->keyframes.end(),
+                                      [](const auto& kf) { return kf->ground.has_value(); });
   std::map<uint64_t, size_t> point_index_of;
   for (const auto& [id, p] : map_.MapPoints()) {
     if (p->bad) continue;
@@ -384,13 +386,13 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
       ++observed;
     }
     if (observed == 0) continue;
-    point_index_of[id] = point_index;
+    if (any_ground) point_index_of[id] = point_index;
     problem.points.push_back(p->position);
     job->points.push_back(p);
   }
   // The road local BA held each keyframe's scale with: without it, the global BA lets the
   // scale drift back (KITTI 00 with PyDNet, docs/loops.md).
-  for (size_t c = 0; c < job->keyframes.size(); ++c)
+  for (size_t c = 0; any_ground && c < job->keyframes.size(); ++c)
     AppendGroundDistances(*job->keyframes[c], c, point_index_of, problem.plane_distances);
   if (event) {
     LoopEvent& e = events_[*event];
