@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "frame_test_util.h"
@@ -100,6 +101,57 @@ TEST(MatcherTest, RotationCheckDropsTheMatchThatTurnedAgainstTheOthers) {
   std::vector<std::shared_ptr<MapPoint>> matches;
   EXPECT_EQ(Matcher(0.9f, true).SearchByDescriptor(*kf, checked, matches), 11);
   EXPECT_EQ(matches[5], nullptr);
+}
+
+// Triangulation's epipolar search (LineSearchGrid's band) finds every pair a keypoint off its
+// epipolar line by up to its pyramid level's tolerance, the top level's too, and no distractor.
+TEST(MatcherTest, TriangulationSearchFindsPairsWithinEachLevelsEpipolarBand) {
+  const Camera camera = testing_util::TestCamera();
+  auto pyramid = std::make_shared<ScalePyramid>(ScalePyramid::Make(8, 1.2f));
+  // Camera 2 one metre to the side: the epipolar lines are the image rows, the epipole far away.
+  const Rigid3d cam2_from_world(Eigen::Translation3d(-1.0, 0.0, 0.0));
+  cv::RNG rng(11);
+  std::vector<cv::KeyPoint> kps1, kps2;
+  const int pairs = 300, distractors = 600;
+  cv::Mat desc1(pairs, 32, CV_8UC1), desc2(pairs + distractors, 32, CV_8UC1);
+  rng.fill(desc1, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(desc2, cv::RNG::UNIFORM, 0, 256);
+  for (int i = 0; i < pairs; ++i) {
+    const Eigen::Vector3d p(rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0), rng.uniform(3.0, 8.0));
+    const Eigen::Vector3d q = cam2_from_world * p;
+    const int octave = i % 8;
+    // Off the line by 0.9x the level's tolerance (sqrt(3.84 sigma^2)), alternately up and down.
+    const float off = 0.9f * std::sqrt(3.84f * pyramid->level_sigma2[octave]) * (i % 2 ? 1 : -1);
+    kps1.emplace_back(cv::Point2f(585 * p.x() / p.z() + 320, 585 * p.y() / p.z() + 240), 31.f, 0.f,
+                      1.f, octave);
+    kps2.emplace_back(cv::Point2f(585 * q.x() / q.z() + 320, 585 * q.y() / q.z() + 240 + off), 31.f,
+                      0.f, 1.f, octave);
+    desc1.row(i).copyTo(desc2.row(i));  // the same point, the same descriptor
+  }
+  for (int j = 0; j < distractors; ++j)
+    kps2.emplace_back(cv::Point2f(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f)), 31.f, 0.f, 1.f,
+                      j % 8);
+  const auto features = [&](const std::vector<cv::KeyPoint>& kps, const cv::Mat& desc) {
+    return MakeFrameFeatures(camera, pyramid, 0.08, 3.2, kps, desc,
+                             std::vector<float>(kps.size(), -1.f), {}, true, true);
+  };
+  Map map;
+  Frame frame1(0, 0, 0.0, features(kps1, desc1)), frame2(1, 1, 0.1, features(kps2, desc2));
+  frame1.cam_from_world = Rigid3d::Identity();
+  frame2.cam_from_world = cam2_from_world;
+  const auto kf1 = map.CreateKeyFrame(frame1), kf2 = map.CreateKeyFrame(frame2);
+  std::vector<std::pair<size_t, size_t>> matches;
+  EXPECT_EQ(Matcher(0.8f, false).SearchForTriangulation(*kf1, *kf2, 0.0, matches), pairs);
+  for (const auto& [i, j] : matches) EXPECT_EQ(i, j);
+
+  // A keypoint just outside its level's band is not matched.
+  kps2[7].pt.y += 0.25f * std::sqrt(3.84f * pyramid->level_sigma2[7]);  // 1.15x the tolerance
+  Frame moved(2, 2, 0.2, features(kps2, desc2));
+  moved.cam_from_world = cam2_from_world;
+  const auto kf3 = map.CreateKeyFrame(moved);
+  matches.clear();
+  EXPECT_EQ(Matcher(0.8f, false).SearchForTriangulation(*kf1, *kf3, 0.0, matches), pairs - 1);
+  for (const auto& [i, j] : matches) EXPECT_NE(i, 7u);
 }
 
 }  // namespace
