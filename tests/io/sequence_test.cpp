@@ -93,6 +93,13 @@ TEST(SevenScenesTest, ReadsFramesDepthPosesAndIntrinsics) {
   EXPECT_EQ(f.depth.at<float>(0, 1), 0.0f);  // 65535 = no reading
   ASSERT_TRUE(f.world_from_cam_gt.has_value());
   EXPECT_EQ(f.world_from_cam_gt->translation().x(), 2.0);
+  // Without its depth image: the same frame otherwise.
+  const FrameData g = seq->LoadWithoutDepth(2);
+  EXPECT_TRUE(g.depth.empty());
+  EXPECT_EQ(g.name, f.name);
+  EXPECT_EQ(cv::norm(g.image, f.image, cv::NORM_INF), 0.0);
+  ASSERT_TRUE(g.world_from_cam_gt.has_value());
+  EXPECT_EQ(g.world_from_cam_gt->translation().x(), 2.0);
 }
 
 TEST(SevenScenesTest, ReportsBadInput) {
@@ -114,6 +121,11 @@ TEST(SevenScenesTest, ReportsBadInput) {
   const auto seq = OpenSequence("7scenes:" + dir.string());
   EXPECT_THAT(ExpectInputError([&] { seq->Load(1); }),
               HasSubstr("frame-000001.color.png: image does not decode"));
+  // A broken depth image fails the frame only where the depth is read.
+  WriteText(dir / "frame-000000.depth.png", "not an image");
+  EXPECT_THAT(ExpectInputError([&] { seq->Load(0); }),
+              HasSubstr("frame-000000.depth.png: image does not decode"));
+  EXPECT_TRUE(seq->LoadWithoutDepth(0).depth.empty());
 
   EXPECT_THAT(ExpectInputError([] { OpenSequence("nope:/tmp"); }),
               HasSubstr("unknown kind 'nope'"));

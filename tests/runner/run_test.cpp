@@ -268,6 +268,36 @@ TEST_F(RunnerTest, ProviderFailureThrowsAndWritesNothing) {
   }
 }
 
+// The dataset's depth images are decoded only for a provider that reads them: a network-like
+// provider gets frames without (and the same trajectory comes out of the same depths).
+TEST_F(RunnerTest, DepthImagesAreDecodedOnlyForAProviderThatReadsThem) {
+  class ReadsNothing : public DepthProvider {
+   public:
+    std::string Name() const override { return "reads-nothing"; }
+    cv::Mat Depth(const FrameData& frame, const Camera& camera) override {
+      saw_depth = saw_depth || !frame.depth.empty();
+      return sensor.Depth(source->Load(frame.index), camera);
+    }
+    FrameDepth sensor;
+    const Sequence* source = nullptr;
+    bool saw_depth = false;
+  };
+  const auto sequence = OpenSequence("tum:" + (dir_ / "office").string());
+  RunOptions options;
+  options.pipeline.end = 30;
+  ReadsNothing network;
+  network.source = sequence.get();
+  const RunReport without = RunSequence(*sequence, &network, nullptr, options);
+  EXPECT_FALSE(network.saw_depth);
+  FrameDepth sensor;
+  const RunReport with = RunSequence(*sequence, &sensor, nullptr, options);
+  ASSERT_GT(with.trajectory.size(), 20u);
+  ASSERT_EQ(without.trajectory.size(), with.trajectory.size());
+  for (size_t i = 0; i < with.trajectory.size(); ++i)
+    EXPECT_TRUE(
+        without.trajectory[i].world_from_cam.isApprox(with.trajectory[i].world_from_cam, 1e-12));
+}
+
 TEST(RunAccuracyTest, ComputedWithEvalOrExplained) {
   Trajectory gt;
   for (int i = 0; i < 40; ++i) {

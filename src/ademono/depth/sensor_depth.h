@@ -15,6 +15,7 @@ class SensorDepthProvider : public DepthProvider {
   // The frame's depth (CV_32FC1 metres). InputError naming the frame if it has none or if its
   // size differs from the image.
   cv::Mat Depth(const FrameData& frame, const Camera& camera) override;
+  bool ReadsSequenceDepth() const override { return true; }
 };
 
 }  // namespace ademono

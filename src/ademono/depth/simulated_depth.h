@@ -63,6 +63,7 @@ class SimulatedDepthProvider : public DepthProvider {
   std::string Name() const override { return "simulated"; }
   // InputError naming the frame when it has no ground-truth depth or it has the wrong size.
   cv::Mat Depth(const FrameData& frame, const Camera& camera) override;
+  bool ReadsSequenceDepth() const override { return ground_truth_ == nullptr; }
   // The degradation alone, for a given ground truth (CV_32FC1 metres) and frame index.
   cv::Mat Degrade(const cv::Mat& depth_m, size_t frame_index) const;
   // The scale bias of frame `frame_index` (scale, times the jitter when it is on).

@@ -18,7 +18,7 @@ FileSequence::FileSequence(FileSequenceSpec spec) : spec_(std::move(spec)) {
 
 double FileSequence::Timestamp(size_t i) const { return spec_.frames.at(i).timestamp; }
 
-FrameData FileSequence::Load(size_t i) const {
+FrameData FileSequence::LoadFrame(size_t i, bool with_depth) const {
   const FileFrame& f = spec_.frames.at(i);
   FrameData frame;
   frame.index = i;
@@ -32,7 +32,7 @@ FrameData FileSequence::Load(size_t i) const {
                                  std::to_string(expected.width) + "x" +
                                  std::to_string(expected.height));
   }
-  if (!f.depth.empty()) {
+  if (with_depth && !f.depth.empty()) {
     frame.depth =
         DepthToMetres(ReadImage(f.depth, cv::IMREAD_UNCHANGED), spec_.depth_scale, f.depth);
     if (frame.depth.size() != frame.image.size()) {

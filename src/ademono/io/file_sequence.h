@@ -43,11 +43,13 @@ class FileSequence : public Sequence {
   const Camera& GetCamera() const override { return spec_.camera; }
   bool HasDepth() const override { return spec_.has_depth; }
   bool HasGroundTruth() const override { return spec_.has_ground_truth; }
-  FrameData Load(size_t i) const override;
+  FrameData Load(size_t i) const override { return LoadFrame(i, true); }
+  FrameData LoadWithoutDepth(size_t i) const override { return LoadFrame(i, false); }
   double Timestamp(size_t i) const override;
   std::optional<double> CameraHeight() const override { return spec_.camera_height; }
 
  private:
+  FrameData LoadFrame(size_t i, bool with_depth) const;
   FileSequenceSpec spec_;
 };
 

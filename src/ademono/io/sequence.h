@@ -35,6 +35,10 @@ class Sequence {
   virtual bool HasGroundTruth() const = 0;
   // Loads frame i (0 <= i < Size()). Throws InputError naming the file if it fails to decode.
   virtual FrameData Load(size_t i) const = 0;
+  // Frame i without the dataset's depth image (FrameData::depth stays empty), for runs whose
+  // depth comes from elsewhere (a network, --depth none): 7-Scenes' 16-bit PNG costs about as
+  // much to decode as its colour JPEG. Sequences without depth files load as Load does.
+  virtual FrameData LoadWithoutDepth(size_t i) const { return Load(i); }
   // Timestamp of frame i without decoding images.
   virtual double Timestamp(size_t i) const = 0;
   // The camera's height above the road in metres when the dataset knows its rig (KITTI: 1.65 m),

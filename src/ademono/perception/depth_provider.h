@@ -19,6 +19,9 @@ class DepthProvider {
   // CV_32FC1 depth in metres at the image's resolution, 0 where invalid.
   // Must be deterministic for the same frame (and seed) and safe to call from a worker thread.
   virtual cv::Mat Depth(const FrameData& frame, const Camera& camera) = 0;
+  // Whether Depth reads FrameData::depth (the dataset's own depth images); when not, the
+  // pipeline loads frames without decoding them (Sequence::LoadWithoutDepth).
+  virtual bool ReadsSequenceDepth() const { return false; }
 };
 
 }  // namespace ademono

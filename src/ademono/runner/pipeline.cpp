@@ -77,7 +77,9 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
   Prepared p;
   const double cpu_start = ThreadCpuMs();
   const auto start = Now();
-  p.frame = sequence.Load(i);
+  // Depth images are decoded only for a provider that reads them (sensor, simulated).
+  const bool with_depth = depth != nullptr && depth->ReadsSequenceDepth();
+  p.frame = with_depth ? sequence.Load(i) : sequence.LoadWithoutDepth(i);
   p.decode_ms = MsSince(start);
   p.cpu_ms = p.decode_cpu_ms = ThreadCpuMs() - cpu_start;
   PrepareLoaded(p, sequence, depth, detector, system, parallel);
