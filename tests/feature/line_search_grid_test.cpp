@@ -64,6 +64,18 @@ TEST(LineSearchGridTest, EmptyAndDegenerateInputsFindNothing) {
   grid.Near(Eigen::Vector3d(1, 0, 0), 1.0, &found);  // through the origin
   std::sort(found.begin(), found.end());
   EXPECT_EQ(found, std::vector<size_t>({0, 1, 2, 3}));
+  // A far outlier keeps the grid small and is still found; infinite bounds: one cell.
+  keypoints[3].pt = cv::Point2f(1e30f, 5.f);
+  const LineSearchGrid far(keypoints, {0, 1, 2, 3});
+  far.Near(Eigen::Vector3d(0, 1, -5), 1.0, &found);  // the row v = 5
+  EXPECT_EQ(std::count(found.begin(), found.end(), 3u), 1);
+  far.Near(Eigen::Vector3d(1, 0, -2e30), 1.0, &found);  // the column u = 2e30: nobody there
+  EXPECT_TRUE(found.empty());
+  keypoints[3].pt = cv::Point2f(INFINITY, 5.f);
+  const LineSearchGrid infinite(keypoints, {0, 1, 2, 3});
+  infinite.Near(Eigen::Vector3d(0, 1, -5), 1.0, &found);
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, std::vector<size_t>({0, 1, 2, 3}));
 }
 
 }  // namespace

@@ -18,11 +18,21 @@ LineSearchGrid::LineSearchGrid(const std::vector<cv::KeyPoint>& keypoints,
     max_x = std::max(max_x, static_cast<double>(p.x));
     max_y = std::max(max_y, static_cast<double>(p.y));
   }
-  // About two keypoints a cell: finer cells cost more visits, coarser ones more tests.
-  const double area = std::max(1.0, (max_x - min_x_) * (max_y - min_y_));
-  cell_ = std::clamp(std::sqrt(2.0 * area / static_cast<double>(indices.size())), 4.0, 256.0);
-  cols_ = std::max(1, static_cast<int>(std::floor((max_x - min_x_) / cell_)) + 1);
-  rows_ = std::max(1, static_cast<int>(std::floor((max_y - min_y_) / cell_)) + 1);
+  // About two keypoints a cell: finer cells cost more visits, coarser ones more tests. At most
+  // kMaxCells a side (a far outlier keypoint), and one cell when the bounds are not finite.
+  constexpr double kMaxCells = 1024;
+  const double width = max_x - min_x_, height = max_y - min_y_;
+  if (!std::isfinite(width) || !std::isfinite(height)) {
+    cols_ = rows_ = 1;
+    offsets_ = {0, indices.size()};
+    indices_ = indices;
+    return;
+  }
+  const double area = std::max(1.0, width * height);
+  cell_ = std::max({4.0, std::sqrt(2.0 * area / static_cast<double>(indices.size())),
+                    width / kMaxCells, height / kMaxCells});
+  cols_ = static_cast<int>(std::floor(width / cell_)) + 1;
+  rows_ = static_cast<int>(std::floor(height / cell_)) + 1;
   std::vector<size_t> cell_of(indices.size());
   offsets_.assign(static_cast<size_t>(cols_) * static_cast<size_t>(rows_) + 1, 0);
   for (size_t k = 0; k < indices.size(); ++k) {
@@ -45,6 +55,10 @@ void LineSearchGrid::Near(const Eigen::Vector3d& line, double radius,
   const double a = line.x(), b = line.y(), c = line.z();
   const double norm = std::hypot(a, b);
   if (!(norm > 0) || !std::isfinite(norm) || !std::isfinite(c)) return;
+  if (cols_ == 1 && rows_ == 1) {  // one cell: every keypoint is a candidate
+    *out = indices_;
+    return;
+  }
   // Walk the strips across the line's main direction; in each, the band spans the line's
   // extent over the strip plus the radius measured along the strip (radius * norm / |the
   // larger coefficient|). A pixel of slack covers rounding.

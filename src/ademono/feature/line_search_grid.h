@@ -18,7 +18,8 @@ class LineSearchGrid {
 
   // Replaces `out` with every bucketed index whose keypoint lies within `radius` pixels of the
   // line l.x() u + l.y() v + l.z() = 0, and more (whole cells): the caller applies its exact
-  // test. In no particular order: a caller that breaks ties by index stays deterministic.
+  // test. In cell order, not index order: a caller that breaks ties towards the lower index
+  // gets what a scan in index order gives.
   void Near(const Eigen::Vector3d& line, double radius, std::vector<size_t>* out) const;
 
  private:
