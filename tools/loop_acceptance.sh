@@ -6,9 +6,11 @@
 # Prints a markdown table. Usage:
 #   tools/loop_acceptance.sh [WORKDIR]     (default /tmp/ademono_loops; sequences are reused)
 # With the loop closed it also runs loop.global_ba=true twice (the repeat must be byte-identical).
+# The street runs get the rig's camera height (1.65 m, as a KITTI drive gets it without a flag), so
+# local and global BA hold the road (depth.ground_in_ba).
 # Env: ADEMONO (the CLI, default build/release/bin/ademono), OFFICE_FRAMES (600),
-# STREET_FRAMES (300), FORWARD_FRAMES (150), SEEDS ("1 2 3"), SEQ_A (../shared/data/7scenes-seq-a;
-# empty: skipped).
+# STREET_FRAMES (300), FORWARD_FRAMES (150), SEEDS ("1 2 3"), SCENES ("office street"), SEQ_A
+# (../shared/data/7scenes-seq-a; empty: skipped).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ADEMONO:-build/release/bin/ademono}
@@ -18,6 +20,7 @@ STREET_FRAMES=${STREET_FRAMES:-300}
 FORWARD_FRAMES=${FORWARD_FRAMES:-150}
 SEEDS=${SEEDS:-1 2 3}
 SEQ_A=${SEQ_A-../shared/data/7scenes-seq-a}
+SCENES=${SCENES:-office street}
 mkdir -p "$W"
 
 synth() {  # name scene motion frames seed
@@ -28,18 +31,19 @@ synth() {  # name scene motion frames seed
 }
 
 run() {  # seq scene loop_enabled out [global_ba]
-  local seq=$1 scene=$2 loop=$3 out=$4 gba=${5:-false} depth config
+  local seq=$1 scene=$2 loop=$3 out=$4 gba=${5:-false} depth config height=()
   if [ "$scene" = street ]; then
     config=configs/network_outdoor.yaml
     depth="simulated:gt=$seq/depth_full,scale=0.88,jitter=0.16,jitter_frames=200"
+    height=(--set depth.camera_height=1.65)
   else
     config=configs/network_indoor.yaml
     depth="simulated:scale=0.88,jitter=0.16,jitter_frames=200"
   fi
   rm -rf "$out"
   "$B" run --overwrite --dataset "tum:$seq" --config "$config" --depth "$depth" \
-    --detector "cache:$seq/detections.jsonl" --set "loop.enabled=$loop" --set "loop.global_ba=$gba" --out "$out" \
-    >"$out.log" 2>&1
+    --detector "cache:$seq/detections.jsonl" --set "loop.enabled=$loop" --set "loop.global_ba=$gba" \
+    "${height[@]}" --out "$out" >"$out.log" 2>&1
 }
 
 row() {  # label summary.json
@@ -59,7 +63,7 @@ PY
 
 echo "| run | tracked | ATE se3 (m) | ATE sim3 (m) | loops |"
 echo "|---|---|---|---|---|"
-for scene in office street; do
+for scene in $SCENES; do
   frames=$OFFICE_FRAMES
   [ "$scene" = street ] && frames=$STREET_FRAMES
   seq=$(synth "${scene}_loop" "$scene" loop "$frames" 1)
@@ -76,7 +80,7 @@ for scene in office street; do
     "$W/run_${scene}_loop_gba_a/summary.json"
 done
 for seed in $SEEDS; do
-  for scene in office street; do
+  for scene in $SCENES; do
     seq=$(synth "${scene}_forward_$seed" "$scene" forward "$FORWARD_FRAMES" "$seed")
     run "$seq" "$scene" true "$W/run_${scene}_forward_$seed"
     row "$scene forward seed $seed (no revisit)" "$W/run_${scene}_forward_$seed/summary.json"
