@@ -2,7 +2,9 @@
 // Keypoints bucketed in square cells so that those near a line (an epipolar line) are found
 // without testing every keypoint: SearchForTriangulation on a 1241x376 KITTI keyframe tested
 // each of ~2,500 free keypoints against every epipolar line of the ~3,000 keypoints of each of
-// 20 neighbours; the band of a line holds about a tenth of them.
+// 20 neighbours; the band of a line holds about a tenth of them. FrameFeatures::grid does not
+// serve here: it holds every keypoint (this a subset, the free ones) and leaves out those
+// undistorted outside the image, which the brute-force search did test.
 
 #include <Eigen/Core>
 #include <cstddef>

@@ -91,6 +91,11 @@ std::vector<KeyFrame*> KeyFrame::BestCovisibles(size_t n) const {
   return result;
 }
 
+bool AnyGround(const std::vector<std::shared_ptr<KeyFrame>>& keyframes) {
+  return std::any_of(keyframes.begin(), keyframes.end(),
+                     [](const auto& kf) { return kf && kf->ground.has_value(); });
+}
+
 void AppendGroundDistances(const KeyFrame& keyframe, size_t camera,
                            const std::map<uint64_t, size_t>& point_index,
                            std::vector<BaPlaneDistance>& distances) {

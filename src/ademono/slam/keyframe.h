@@ -81,5 +81,8 @@ class KeyFrame {
 void AppendGroundDistances(const KeyFrame& keyframe, size_t camera,
                            const std::map<uint64_t, size_t>& point_index,
                            std::vector<BaPlaneDistance>& distances);
+// Whether any of `keyframes` (null entries allowed) has a road: only then does a bundle
+// adjustment need the point index AppendGroundDistances reads.
+bool AnyGround(const std::vector<std::shared_ptr<KeyFrame>>& keyframes);
 
 }  // namespace ademono

@@ -414,8 +414,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     // accepts that, but a fixed frame keeps repeated runs anchored.
     problem.intrinsics = keyframe.F().intrinsics;
     // Point ids to problem indices, only for the road residuals below (depth.ground_in_ba).
-    const bool any_ground = std::any_of(cameras.begin(), cameras.end(),
-                                        [](const auto& kf) { return kf && kf->ground; });
+    const bool any_ground = AnyGround(cameras);
     std::map<uint64_t, size_t> point_index_of;
     // mapping.network_scale_prior: the relative sigma of each network depth of a free keyframe.
     std::map<const KeyFrame*, double> scale_prior_sigma;

@@ -372,8 +372,7 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
     job->keyframes.push_back(kf);
   }
   // Map point id -> problem index, only for the road's residuals below (depth.ground_in_ba).
-  const bool any_ground = std::any_of(job->keyframes.begin(), job->keyframes.end(),
-                                      [](const auto& kf) { return kf->ground.has_value(); });
+  const bool any_ground = AnyGround(job->keyframes);
   std::map<uint64_t, size_t> point_index_of;
   for (const auto& [id, p] : map_.MapPoints()) {
     if (p->bad) continue;
