@@ -1,9 +1,10 @@
 // One local bundle adjustment on a real problem recorded from 7-Scenes seq-a (sensor depth,
 // configs/7scenes.yaml), tests/data/ba/seq_a_local_ba.bin, solved with each lever side by side:
-// auto-diff vs analytic Jacobians, Ceres' linear solver, iteration counts. Arguments of BM_LocalBa:
-//   jacobians (0 autodiff, 1 analytic), solver (0 sparse_schur, 1 dense_schur,
-//   2 iterative_schur). Ceres' threads are not a lever: 2 threads change the results' bits.
-// BM_LocalBaIterations varies ba_first_iterations / ba_second_iterations (analytic, sparse).
+// the built-in LM (optimize/schur_lm.h) against Ceres, auto-diff vs analytic Jacobians, Ceres'
+// linear solver, iteration counts. Arguments of BM_LocalBa: jacobians (0 autodiff, 1 analytic;
+// Ceres only), solver (0 sparse_schur, 1 dense_schur, 2 iterative_schur: Ceres; 3 the built-in LM).
+// Ceres' threads are not a lever: 2 threads change the results' bits.
+// BM_LocalBaIterations varies ba_first_iterations / ba_second_iterations (the default solver).
 //
 // Re-record the problem (the local BA of the last keyframe after --frames frames):
 //   build/release/bench_ba --record=tests/data/ba/seq_a_local_ba.bin --frames=120
@@ -44,7 +45,12 @@ void Describe(benchmark::State& state, const ademono::BundleAdjustmentResult& re
 void BM_LocalBa(benchmark::State& state) {
   ademono::BundleAdjustmentOptions options;
   options.analytic_jacobians = state.range(0) != 0;
-  options.linear_solver = static_cast<ademono::BaLinearSolver>(state.range(1));
+  if (state.range(1) == 3) {
+    options.solver = ademono::BaSolver::kLm;
+  } else {
+    options.solver = ademono::BaSolver::kCeres;
+    options.linear_solver = static_cast<ademono::BaLinearSolver>(state.range(1));
+  }
   ademono::BundleAdjustmentResult result;
   for (auto _ : state) {
     result = ademono::SolveBundleAdjustment(Problem(), options);
@@ -59,6 +65,7 @@ BENCHMARK(BM_LocalBa)
     ->Args({1, 0})
     ->Args({1, 1})
     ->Args({1, 2})
+    ->Args({1, 3})
     ->Unit(benchmark::kMillisecond);
 
 void BM_LocalBaIterations(benchmark::State& state) {

@@ -127,11 +127,13 @@ TEST(BundleAdjustmentTest, AnalyticJacobiansSolveLikeAutoDiffWithEverySolver) {
   std::vector<Eigen::Vector3d> points;
   const BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
   BundleAdjustmentOptions reference_options;
+  reference_options.solver = BaSolver::kCeres;
   reference_options.analytic_jacobians = false;
   const auto reference = SolveBundleAdjustment(problem, reference_options);
   for (BaLinearSolver solver : {BaLinearSolver::kSparseSchur, BaLinearSolver::kDenseSchur,
                                 BaLinearSolver::kIterativeSchur}) {
     BundleAdjustmentOptions options;
+    options.solver = BaSolver::kCeres;
     options.linear_solver = solver;
     const auto result = SolveBundleAdjustment(problem, options);
     // The iterative solver stops at its own tolerance: close, not as close.
@@ -149,8 +151,11 @@ TEST(BundleAdjustmentTest, AnalyticJacobiansSolveLikeAutoDiffWithEverySolver) {
 
 TEST(BundleAdjustmentTest, OptionsReadAndRejectUnknownChoices) {
   const auto options = ReadOptions<BundleAdjustmentOptions>(
-      YAML::Load("{ba_jacobians: autodiff, ba_linear_solver: dense_schur}"));
+      YAML::Load("{ba_jacobians: autodiff, ba_linear_solver: dense_schur, ba_solver: ceres}"));
   EXPECT_FALSE(options.analytic_jacobians);
+  EXPECT_EQ(options.solver, BaSolver::kCeres);
+  EXPECT_EQ(BundleAdjustmentOptions().solver, BaSolver::kLm);
+  EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_solver: g2o}")));
   EXPECT_EQ(options.linear_solver, BaLinearSolver::kDenseSchur);
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_linear_solver: qr}")));
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_jacobians: numeric}")));
@@ -311,6 +316,80 @@ TEST(BundleAdjustmentTest, AFreeRoadNormalKeepsAMisreadTiltOutOfTheWindow) {
   EXPECT_NEAR(free_window.Scale(solved), 1.0, 0.01);
   EXPECT_LT(free_window.RotationErrorDeg(solved), 0.1);
   EXPECT_GT(std::abs(held_window.Scale(held) - 1.0), 0.1);  // measured 0.77
+}
+
+// The built-in LM runs Ceres' iteration: on the same problem, both solvers give the same
+// outliers and agree to far below a pixel's worth of motion.
+double MaxCameraDifference(const BundleAdjustmentResult& a, const BundleAdjustmentResult& b) {
+  double worst = 0;
+  for (size_t c = 0; c < a.cam_from_world.size(); ++c) {
+    worst = std::max(
+        worst, (a.cam_from_world[c].matrix() - b.cam_from_world[c].matrix()).cwiseAbs().maxCoeff());
+  }
+  return worst;
+}
+double MaxPointDifference(const BundleAdjustmentResult& a, const BundleAdjustmentResult& b) {
+  double worst = 0;
+  for (size_t p = 0; p < a.points.size(); ++p)
+    worst = std::max(worst, (a.points[p] - b.points[p]).cwiseAbs().maxCoeff());
+  return worst;
+}
+BundleAdjustmentResult SolveWith(const BundleAdjustmentProblem& problem, BaSolver solver,
+                                 BundleAdjustmentOptions options = {}) {
+  options.solver = solver;
+  return SolveBundleAdjustment(problem, options);
+}
+
+TEST(BundleAdjustmentTest, LmSolverMatchesCeresOnStereoAndMonocularObservations) {
+  std::mt19937 rng(13);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  problem.observations[10].image.pixel += Eigen::Vector2d(50, 50);  // an outlier
+  problem.point_fixed.assign(problem.points.size(), 0);
+  problem.point_fixed[3] = 1;
+  const auto ceres = SolveWith(problem, BaSolver::kCeres);
+  const auto lm = SolveWith(problem, BaSolver::kLm);
+  EXPECT_EQ(lm.outlier, ceres.outlier);
+  EXPECT_TRUE(lm.outlier[10]);
+  EXPECT_LT(MaxCameraDifference(lm, ceres), 1e-7);
+  EXPECT_LT(MaxPointDifference(lm, ceres), 1e-6);
+  EXPECT_TRUE(lm.points[3] == problem.points[3]);
+  EXPECT_TRUE(lm.cam_from_world[0].matrix() == problem.cameras[0].cam_from_world.matrix());
+  EXPECT_TRUE(lm.converged);
+  const auto again = SolveWith(problem, BaSolver::kLm);
+  EXPECT_EQ(MaxCameraDifference(lm, again), 0.0);
+  EXPECT_EQ(MaxPointDifference(lm, again), 0.0);
+}
+
+TEST(BundleAdjustmentTest, LmSolverMatchesCeresWithHeldAndSolvedRoadNormals) {
+  const Eigen::Vector3d tilted =
+      Eigen::AngleAxisd(3 * M_PI / 180, Eigen::Vector3d::UnitX()) * Eigen::Vector3d(0, -1, 0);
+  for (int plane : {-1, 0}) {
+    RoadWindow window;
+    window.HoldRoad(tilted, plane);
+    const auto ceres = SolveWith(window.problem, BaSolver::kCeres, LongSolve());
+    const auto lm = SolveWith(window.problem, BaSolver::kLm, LongSolve());
+    EXPECT_EQ(lm.outlier, ceres.outlier) << plane;
+    EXPECT_LT(MaxCameraDifference(lm, ceres), 1e-6) << plane;
+    EXPECT_LT(MaxPointDifference(lm, ceres), 1e-5) << plane;
+    EXPECT_NEAR(window.Scale(lm), window.Scale(ceres), 1e-6) << plane;
+  }
+}
+
+// A real local BA (7-Scenes seq-a, 44 cameras, 1,871 points, 10,060 observations).
+TEST(BundleAdjustmentTest, LmSolverMatchesCeresOnARecordedLocalWindow) {
+  const BundleAdjustmentProblem problem = ReadBundleAdjustmentProblem(
+      std::string(ADEMONO_SOURCE_DIR) + "/tests/data/ba/seq_a_local_ba.bin");
+  const auto ceres = SolveWith(problem, BaSolver::kCeres);
+  const auto lm = SolveWith(problem, BaSolver::kLm);
+  int differing = 0;
+  for (size_t i = 0; i < lm.outlier.size(); ++i) differing += lm.outlier[i] != ceres.outlier[i];
+  std::cout << "LM vs Ceres: cameras " << MaxCameraDifference(lm, ceres) << ", points "
+            << MaxPointDifference(lm, ceres) << ", outliers differing " << differing << "\n";
+  EXPECT_EQ(differing, 0);
+  EXPECT_LT(MaxCameraDifference(lm, ceres), 1e-9);  // measured 1e-16
+  EXPECT_LT(MaxPointDifference(lm, ceres), 1e-8);   // measured 4e-14
 }
 
 }  // namespace

@@ -1,15 +1,16 @@
 #include "ademono/optimize/bundle_adjustment.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 
-#include <spdlog/spdlog.h>
-
 #include "ademono/core/options_table.h"
 #include "ademono/optimize/residuals.h"
+#include "ademono/optimize/schur_lm.h"
 
 namespace ademono {
 
@@ -21,6 +22,8 @@ const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
           .Add("ba_second_iterations", &B::second_iterations, Range::AtLeast(0))
           .AddChoice<bool>("ba_jacobians", &B::analytic_jacobians,
                            {{"analytic", true}, {"autodiff", false}})
+          .AddChoice<BaSolver>("ba_solver", &B::solver,
+                               {{"lm", BaSolver::kLm}, {"ceres", BaSolver::kCeres}})
           .AddChoice<BaLinearSolver>("ba_linear_solver", &B::linear_solver,
                                      {{"sparse_schur", BaLinearSolver::kSparseSchur},
                                       {"dense_schur", BaLinearSolver::kDenseSchur},
@@ -70,10 +73,10 @@ struct PlaneDistanceResidual {
 };
 
 // Solves with the observations not flagged in `skip`; returns whether Ceres converged.
-bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
-           const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
-           std::vector<double>& points, double* normals,
-           const std::vector<size_t>& normal_slot) {
+bool SolveWithCeres(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
+                    const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
+                    std::vector<double>& points, double* normals,
+                    const std::vector<size_t>& normal_slot) {
   ceres::Problem ceres_problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<bool> point_used(problem.points.size(), false),
@@ -155,6 +158,17 @@ bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions
                 summary.message);
   return summary.termination_type == ceres::CONVERGENCE ||
          summary.termination_type == ceres::NO_CONVERGENCE;
+}
+
+bool Solve(const BundleAdjustmentProblem& problem, const BundleAdjustmentOptions& ba,
+           const std::vector<bool>& skip, int iterations, std::vector<double>& cameras,
+           std::vector<double>& points, double* normals, const std::vector<size_t>& normal_slot) {
+  size_t free_cameras = 0;
+  for (const BaCamera& c : problem.cameras) free_cameras += c.fixed ? 0 : 1;
+  if (ba.solver == BaSolver::kLm && free_cameras <= BundleAdjustmentOptions::kMaxLmFreeCameras) {
+    return internal::SolveSchurLm(problem, skip, iterations, cameras, points, normals, normal_slot);
+  }
+  return SolveWithCeres(problem, ba, skip, iterations, cameras, points, normals, normal_slot);
 }
 
 void ClassifyOutliers(const BundleAdjustmentProblem& problem, const std::vector<double>& cameras,

@@ -21,14 +21,23 @@ class OptionsTable;
 // the measured trade-off).
 enum class BaLinearSolver { kSparseSchur, kDenseSchur, kIterativeSchur };
 
+// Who solves: the built-in Levenberg-Marquardt on a dense Schur complement (optimize/schur_lm.h:
+// Ceres' iteration at about a third of its cost on a local window), or Ceres with
+// `linear_solver`. The dense reduced system suits windows, so a problem with more than
+// kMaxLmFreeCameras free cameras goes to Ceres whatever the choice.
+enum class BaSolver { kLm, kCeres };
+
 struct BundleAdjustmentOptions {
   int first_iterations = 5;
   int second_iterations = 10;
   bool analytic_jacobians = true;  // false: Ceres auto-diff (the reference the tests compare to)
   BaLinearSolver linear_solver = BaLinearSolver::kSparseSchur;
+  BaSolver solver = BaSolver::kLm;
+  static constexpr size_t kMaxLmFreeCameras = 64;
   void Check() const;  // throws std::invalid_argument
   // Its keys in the flat `mapping:` node: ba_first_iterations, ba_second_iterations,
-  // ba_jacobians (analytic|autodiff), ba_linear_solver (sparse_schur|dense_schur|iterative_schur).
+  // ba_jacobians (analytic|autodiff, Ceres only), ba_solver (lm|ceres), ba_linear_solver
+  // (sparse_schur|dense_schur|iterative_schur, Ceres only).
   // Ceres runs on one thread: with 2 its sums are ordered differently and results are no longer
   // byte-identical (measured, docs/performance.md).
   static const OptionsTable<BundleAdjustmentOptions>& Table();

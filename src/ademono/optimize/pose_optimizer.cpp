@@ -6,6 +6,7 @@
 
 #include "ademono/core/options_table.h"
 #include "ademono/optimize/residuals.h"
+#include "ademono/optimize/trust_region.h"
 
 namespace ademono {
 
@@ -49,17 +50,11 @@ struct LmProblem {
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 
-// Huber as Ceres' HuberLoss(a) on s = |r|^2: rho = s (s <= a^2) else 2 a sqrt(s) - a^2. Returns
-// rho and sets rho' (Ceres' corrector scales J and r by sqrt(rho') since rho'' <= 0 here).
+// Huber (trust_region.h) in the robust rounds, plain squares in the last.
 inline double Huber(double s, double a2, bool robust, double* rho1) {
-  if (!robust || s <= a2) {
-    *rho1 = 1.0;
-    return s;
-  }
-  const double root = std::sqrt(s);
-  const double a = std::sqrt(a2);
-  *rho1 = a / root;
-  return 2.0 * a * root - a2;
+  if (robust) return internal::HuberRho(s, a2, rho1);
+  *rho1 = 1.0;
+  return s;
 }
 
 // 1/2 sum rho(|r|^2) at `camera`; with h and g also J^T W J and J^T W r (W = rho').
@@ -89,49 +84,50 @@ double LmEvaluate(const LmProblem& p, const double* camera, Matrix6* h, Vector6*
   return cost;
 }
 
-// Levenberg-Marquardt as Ceres' TrustRegionMinimizer with its defaults (initial radius 1e4,
-// Jacobi scaling, LM diagonal clamped to [1e-6, 1e32], step quality 1e-3, function tolerance
-// 1e-6, gradient tolerance 1e-10, parameter tolerance 1e-8), at most `max_iterations` steps.
+// Levenberg-Marquardt as Ceres' TrustRegionMinimizer with its defaults (trust_region.h), at most
+// `max_iterations` steps.
 void LmSolve(const LmProblem& p, double* camera, int max_iterations) {
   Matrix6 h;
   Vector6 g;
   double cost = LmEvaluate(p, camera, &h, &g);
-  double radius = 1e4, decrease_factor = 2.0;
+  internal::LmTrustRegion region;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
-    if (g.cwiseAbs().maxCoeff() <= 1e-10) return;
+    if (g.cwiseAbs().maxCoeff() <= internal::kLmGradientTolerance) return;
     // Jacobi scaling of the columns: 1 / (1 + |J_col|).
     Vector6 scale;
     for (int c = 0; c < 6; ++c) scale[c] = 1.0 / (1.0 + std::sqrt(h(c, c)));
     const Matrix6 hs = scale.asDiagonal() * h * scale.asDiagonal();
     const Vector6 gs = scale.cwiseProduct(g);
     Matrix6 a = hs;
-    for (int c = 0; c < 6; ++c) a(c, c) += std::clamp(hs(c, c), 1e-6, 1e32) / radius;
+    for (int c = 0; c < 6; ++c)
+      a(c, c) += std::clamp(hs(c, c), internal::kLmMinDiagonal, internal::kLmMaxDiagonal) /
+                 region.Radius();
     const Vector6 step_scaled = -a.ldlt().solve(gs);
     const Vector6 step = scale.cwiseProduct(step_scaled);
     const Eigen::Map<const Vector6> x(camera);
     if (!step.allFinite()) {
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
+      region.Rejected();
       continue;
     }
     // Model decrease of the Gauss-Newton model (not the damped one), as Ceres.
     const double model_decrease = -(g.dot(step) + 0.5 * step.dot(h * step));
-    if (step.norm() <= 1e-8 * (x.norm() + 1e-8)) return;
+    if (step.norm() <=
+        internal::kLmParameterTolerance * (x.norm() + internal::kLmParameterTolerance))
+      return;
     Vector6 candidate = x + step;
     const double new_cost = LmEvaluate(p, candidate.data(), nullptr, nullptr);
     // Function tolerance: a change below 1e-6 of the cost ends the solve (candidate not taken).
-    if (std::isfinite(new_cost) && std::abs(cost - new_cost) <= 1e-6 * cost) return;
+    if (std::isfinite(new_cost) &&
+        std::abs(cost - new_cost) <= internal::kLmFunctionTolerance * cost)
+      return;
     const double quality = model_decrease > 0 ? (cost - new_cost) / model_decrease : -1.0;
-    if (std::isfinite(new_cost) && quality > 1e-3) {
+    if (std::isfinite(new_cost) && quality > internal::kLmMinRelativeDecrease) {
       std::copy(candidate.data(), candidate.data() + 6, camera);
       cost = LmEvaluate(p, camera, &h, &g);
-      const double t = 2.0 * quality - 1.0;
-      radius = std::min(1e16, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
-      decrease_factor = 2.0;
+      region.Accepted(quality);
     } else {
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
-      if (radius < 1e-32) return;
+      region.Rejected();
+      if (region.Collapsed()) return;
     }
   }
 }

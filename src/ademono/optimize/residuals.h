@@ -90,11 +90,47 @@ struct BaResidual : ProjectionResidual<kDim> {
   }
 };
 
+// R(omega) and d(R X)/d omega, matching how Ceres' AngleAxisRotatePoint computed q = R X:
+//   d(R X)/d omega = -[q]x J_l(omega),
+// J_l being SO(3)'s left Jacobian; below Ceres' small-angle threshold AngleAxisRotatePoint uses
+// X + omega x X, whose derivative is -[X]x.
+inline void RotationDerivatives(const double* camera, const double* point_world, const double* q,
+                                Eigen::Matrix3d& rotation, Eigen::Matrix3d& dq_domega) {
+  using Mat3 = Eigen::Matrix3d;
+  const Eigen::Map<const Eigen::Vector3d> omega(camera);
+  const double theta2 = omega.squaredNorm();
+  const bool small = !(theta2 > std::numeric_limits<double>::epsilon());  // Ceres' branch
+  auto skew = [](const Eigen::Vector3d& v) {
+    Mat3 m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+  };
+  if (small) {
+    const Mat3 omega_x = skew(omega);
+    rotation = Mat3::Identity() + omega_x;
+    dq_domega = -skew(Eigen::Map<const Eigen::Vector3d>(point_world));
+    return;
+  }
+  const double theta = std::sqrt(theta2);
+  // (1 - cos)/theta^2 and (theta - sin)/theta^3, by series where they cancel badly.
+  double a, b;
+  if (theta < 1e-2) {
+    a = 0.5 - theta2 / 24.0 + theta2 * theta2 / 720.0;
+    b = 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
+  } else {
+    a = (1.0 - std::cos(theta)) / theta2;
+    b = (theta - std::sin(theta)) / (theta2 * theta);
+  }
+  const Mat3 omega_x = skew(omega);
+  const Mat3 jl = Mat3::Identity() + a * omega_x + b * omega_x * omega_x;
+  ceres::AngleAxisToRotationMatrix(camera, ceres::ColumnMajorAdapter3x3(rotation.data()));
+  dq_domega = -skew(Eigen::Vector3d(q[0], q[1], q[2])) * jl;
+}
+
 // The same residual with closed-form Jacobians (about 3x cheaper than auto-diff's dual numbers).
-// camera = (omega, t) of cam_from_world: p = R(omega) X + t. With q = R X,
-//   dp/domega = -[q]x J_l(omega),  dp/dt = I,  dp/dX = R,
-// J_l being SO(3)'s left Jacobian. Below Ceres' small-angle threshold AngleAxisRotatePoint uses
-// X + omega x X, whose derivative is -[X]x; the depth clamp has zero derivative, as in auto-diff.
+// camera = (omega, t) of cam_from_world: p = R(omega) X + t, so dp/domega is d(R X)/d omega
+// (RotationDerivatives), dp/dt = I and dp/dX = R; the depth clamp has zero derivative, as in
+// auto-diff.
 // `jac_camera` is kDim x 6 and `jac_point` kDim x 3, row-major; either may be null.
 template <int kDim>
 void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
@@ -114,7 +150,6 @@ void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
   if constexpr (kDim == 3) residual[2] = r.depth_scale * (pu - k.bf * inv_z - r.ur);
   if (jac_camera == nullptr && jac_point == nullptr) return;
 
-  using Mat3 = Eigen::Matrix3d;
   Eigen::Matrix<double, kDim, 3> dr_dp;
   const double inv_z2 = clamped ? 0.0 : inv_z * inv_z;
   dr_dp.row(0) << r.scale * k.fx * inv_z, 0.0, -r.scale * k.fx * p[0] * inv_z2;
@@ -123,36 +158,9 @@ void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
     dr_dp.row(2) << r.depth_scale * k.fx * inv_z, 0.0,
         r.depth_scale * (k.bf - k.fx * p[0]) * inv_z2;
 
-  const Eigen::Map<const Eigen::Vector3d> omega(camera);
-  const double theta2 = omega.squaredNorm();
-  const bool small = !(theta2 > std::numeric_limits<double>::epsilon());  // Ceres' branch
-  auto skew = [](const Eigen::Vector3d& v) {
-    Mat3 m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-  };
-  Mat3 rotation;
-  Mat3 dp_domega;
-  if (small) {
-    const Mat3 omega_x = skew(omega);
-    rotation = Mat3::Identity() + omega_x;
-    dp_domega = -skew(Eigen::Map<const Eigen::Vector3d>(point_world));
-  } else {
-    const double theta = std::sqrt(theta2);
-    // (1 - cos)/theta^2 and (theta - sin)/theta^3, by series where they cancel badly.
-    double a, b;
-    if (theta < 1e-2) {
-      a = 0.5 - theta2 / 24.0 + theta2 * theta2 / 720.0;
-      b = 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
-    } else {
-      a = (1.0 - std::cos(theta)) / theta2;
-      b = (theta - std::sin(theta)) / (theta2 * theta);
-    }
-    const Mat3 omega_x = skew(omega);
-    const Mat3 jl = Mat3::Identity() + a * omega_x + b * omega_x * omega_x;
-    ceres::AngleAxisToRotationMatrix(camera, ceres::ColumnMajorAdapter3x3(rotation.data()));
-    dp_domega = -skew(Eigen::Vector3d(q[0], q[1], q[2])) * jl;
-  }
+  Eigen::Matrix3d rotation;
+  Eigen::Matrix3d dp_domega;
+  RotationDerivatives(camera, point_world, q, rotation, dp_domega);
   if (jac_camera != nullptr) {
     Eigen::Map<Eigen::Matrix<double, kDim, 6, Eigen::RowMajor>> j(jac_camera);
     j.template leftCols<3>() = dr_dp * dp_domega;

@@ -401,6 +401,7 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
   }
   if (problem.cameras.size() < 2 || problem.points.empty()) return;
   BundleAdjustmentOptions ba;
+  ba.solver = BaSolver::kCeres;  // the whole map: a sparse reduced system
   ba.first_iterations = options_.global_ba_iterations;
   ba.second_iterations = options_.global_ba_iterations;
   GlobalBa* raw = job.get();
