@@ -76,16 +76,26 @@ Eigen::Matrix3d Normalize(const std::vector<Eigen::Vector2d>& points,
   return T;
 }
 
+// The unit vector x minimising |A x| for the DLT rows accumulated in `ata` = A^T A: its
+// eigenvector of the smallest eigenvalue (as OpenCV's 8-point and homography kernels). A fixed
+// 9x9 eigen-solve instead of an SVD of the 2n x 9 (or n x 9) A: several times cheaper in the
+// RANSAC loop, and the normalised coordinates keep A^T A well conditioned.
+Eigen::Matrix<double, 9, 1> NullVector(const Eigen::Matrix<double, 9, 9>& ata) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eigen(ata);
+  return eigen.eigenvectors().col(0);
+}
+
 Eigen::Matrix3d HomographyFromNormalized(const std::vector<Eigen::Vector2d>& p1,
                                          const std::vector<Eigen::Vector2d>& p2) {
-  Eigen::MatrixXd A(2 * p1.size(), 9);
+  Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
   for (size_t i = 0; i < p1.size(); ++i) {
     const double u1 = p1[i].x(), v1 = p1[i].y(), u2 = p2[i].x(), v2 = p2[i].y();
-    A.row(2 * i) << 0, 0, 0, -u1, -v1, -1, v2 * u1, v2 * v1, v2;
-    A.row(2 * i + 1) << u1, v1, 1, 0, 0, 0, -u2 * u1, -u2 * v1, -u2;
+    Eigen::Matrix<double, 9, 1> a, b;
+    a << 0, 0, 0, -u1, -v1, -1, v2 * u1, v2 * v1, v2;
+    b << u1, v1, 1, 0, 0, 0, -u2 * u1, -u2 * v1, -u2;
+    ata.noalias() += a * a.transpose() + b * b.transpose();
   }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
-  const Eigen::VectorXd h = svd.matrixV().col(8);
+  const Eigen::Matrix<double, 9, 1> h = NullVector(ata);
   Eigen::Matrix3d H;
   H << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
   return H;
@@ -93,13 +103,14 @@ Eigen::Matrix3d HomographyFromNormalized(const std::vector<Eigen::Vector2d>& p1,
 
 Eigen::Matrix3d FundamentalFromNormalized(const std::vector<Eigen::Vector2d>& p1,
                                           const std::vector<Eigen::Vector2d>& p2) {
-  Eigen::MatrixXd A(p1.size(), 9);
+  Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
   for (size_t i = 0; i < p1.size(); ++i) {
     const double u1 = p1[i].x(), v1 = p1[i].y(), u2 = p2[i].x(), v2 = p2[i].y();
-    A.row(i) << u2 * u1, u2 * v1, u2, v2 * u1, v2 * v1, v2, u1, v1, 1;
+    Eigen::Matrix<double, 9, 1> a;
+    a << u2 * u1, u2 * v1, u2, v2 * u1, v2 * v1, v2, u1, v1, 1;
+    ata.noalias() += a * a.transpose();
   }
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
-  const Eigen::VectorXd f = svd.matrixV().col(8);
+  const Eigen::Matrix<double, 9, 1> f = NullVector(ata);
   Eigen::Matrix3d F;
   F << f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7), f(8);
   // Rank 2: a fundamental matrix has a null space (the epipole).

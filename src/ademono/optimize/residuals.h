@@ -90,55 +90,61 @@ struct BaResidual : ProjectionResidual<kDim> {
   }
 };
 
-// R(omega) and d(R X)/d omega, matching how Ceres' AngleAxisRotatePoint computed q = R X:
-//   d(R X)/d omega = -[q]x J_l(omega),
-// J_l being SO(3)'s left Jacobian; below Ceres' small-angle threshold AngleAxisRotatePoint uses
-// X + omega x X, whose derivative is -[X]x.
-inline void RotationDerivatives(const double* camera, const double* point_world, const double* q,
-                                Eigen::Matrix3d& rotation, Eigen::Matrix3d& dq_domega) {
-  using Mat3 = Eigen::Matrix3d;
-  const Eigen::Map<const Eigen::Vector3d> omega(camera);
-  const double theta2 = omega.squaredNorm();
-  const bool small = !(theta2 > std::numeric_limits<double>::epsilon());  // Ceres' branch
-  auto skew = [](const Eigen::Vector3d& v) {
-    Mat3 m;
+// A camera's rotation and what its derivatives need, computed once per camera: R(omega) (Ceres'
+// AngleAxisToRotationMatrix) and SO(3)'s left Jacobian J_l(omega), so that
+//   d(R X)/d omega = -[q]x J_l(omega)  at q = R X;
+// below Ceres' small-angle threshold AngleAxisRotatePoint uses X + omega x X, whose derivative
+// is -[X]x.
+struct CameraRotation {
+  Eigen::Matrix3d rotation;
+  Eigen::Matrix3d left_jacobian;  // unused when small
+  bool small = false;
+
+  CameraRotation() = default;
+  static Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
     m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
     return m;
-  };
-  if (small) {
-    const Mat3 omega_x = skew(omega);
-    rotation = Mat3::Identity() + omega_x;
-    dq_domega = -skew(Eigen::Map<const Eigen::Vector3d>(point_world));
-    return;
   }
-  const double theta = std::sqrt(theta2);
-  // (1 - cos)/theta^2 and (theta - sin)/theta^3, by series where they cancel badly.
-  double a, b;
-  if (theta < 1e-2) {
-    a = 0.5 - theta2 / 24.0 + theta2 * theta2 / 720.0;
-    b = 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
-  } else {
-    a = (1.0 - std::cos(theta)) / theta2;
-    b = (theta - std::sin(theta)) / (theta2 * theta);
+  explicit CameraRotation(const double* camera) {
+    using Mat3 = Eigen::Matrix3d;
+    const Eigen::Map<const Eigen::Vector3d> omega(camera);
+    const double theta2 = omega.squaredNorm();
+    small = !(theta2 > std::numeric_limits<double>::epsilon());  // Ceres' branch
+    const Mat3 omega_x = Skew(omega);
+    if (small) {
+      rotation = Mat3::Identity() + omega_x;
+      return;
+    }
+    const double theta = std::sqrt(theta2);
+    // (1 - cos)/theta^2 and (theta - sin)/theta^3, by series where they cancel badly.
+    double a, b;
+    if (theta < 1e-2) {
+      a = 0.5 - theta2 / 24.0 + theta2 * theta2 / 720.0;
+      b = 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0;
+    } else {
+      a = (1.0 - std::cos(theta)) / theta2;
+      b = (theta - std::sin(theta)) / (theta2 * theta);
+    }
+    left_jacobian = Mat3::Identity() + a * omega_x + b * omega_x * omega_x;
+    ceres::AngleAxisToRotationMatrix(camera, ceres::ColumnMajorAdapter3x3(rotation.data()));
   }
-  const Mat3 omega_x = skew(omega);
-  const Mat3 jl = Mat3::Identity() + a * omega_x + b * omega_x * omega_x;
-  ceres::AngleAxisToRotationMatrix(camera, ceres::ColumnMajorAdapter3x3(rotation.data()));
-  dq_domega = -skew(Eigen::Vector3d(q[0], q[1], q[2])) * jl;
-}
+  // d(R X)/d omega for the point X rotated to q.
+  Eigen::Matrix3d DerivativeAt(const double* point_world, const double* q) const {
+    if (small) return -Skew(Eigen::Map<const Eigen::Vector3d>(point_world));
+    return -Skew(Eigen::Vector3d(q[0], q[1], q[2])) * left_jacobian;
+  }
+};
 
-// The same residual with closed-form Jacobians (about 3x cheaper than auto-diff's dual numbers).
-// camera = (omega, t) of cam_from_world: p = R(omega) X + t, so dp/domega is d(R X)/d omega
-// (RotationDerivatives), dp/dt = I and dp/dX = R; the depth clamp has zero derivative, as in
-// auto-diff.
-// `jac_camera` is kDim x 6 and `jac_point` kDim x 3, row-major; either may be null.
+// The projection residual (u, v[, u_right]) scaled by 1/sigma and, when asked, its Jacobians,
+// from the rotated point q = R X and the camera's translation t (p = q + t); `rotation` gives
+// R and d q/d omega. `jac_camera` is kDim x 6 and `jac_point` kDim x 3, row-major; either may be
+// null. The depth clamp has zero derivative, as in auto-diff.
 template <int kDim>
-void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
-                        const double* point_world, double* residual, double* jac_camera,
-                        double* jac_point) {
-  double q[3];
-  ceres::AngleAxisRotatePoint(camera, point_world, q);
-  double p[3] = {q[0] + camera[3], q[1] + camera[4], q[2] + camera[5]};
+void ProjectRotated(const ProjectionResidual<kDim>& r, const double* q, const double* t,
+                    const double* point_world, const CameraRotation* rotation, double* residual,
+                    double* jac_camera, double* jac_point) {
+  double p[3] = {q[0] + t[0], q[1] + t[1], q[2] + t[2]};
   const bool clamped = p[2] < 1e-3;
   if (clamped) p[2] = 1e-3;
   const double inv_z = 1.0 / p[2];
@@ -157,19 +163,32 @@ void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
   if constexpr (kDim == 3)
     dr_dp.row(2) << r.depth_scale * k.fx * inv_z, 0.0,
         r.depth_scale * (k.bf - k.fx * p[0]) * inv_z2;
-
-  Eigen::Matrix3d rotation;
-  Eigen::Matrix3d dp_domega;
-  RotationDerivatives(camera, point_world, q, rotation, dp_domega);
   if (jac_camera != nullptr) {
     Eigen::Map<Eigen::Matrix<double, kDim, 6, Eigen::RowMajor>> j(jac_camera);
-    j.template leftCols<3>() = dr_dp * dp_domega;
+    j.template leftCols<3>() = dr_dp * rotation->DerivativeAt(point_world, q);
     j.template rightCols<3>() = dr_dp;
   }
   if (jac_point != nullptr) {
     Eigen::Map<Eigen::Matrix<double, kDim, 3, Eigen::RowMajor>> j(jac_point);
-    j = dr_dp * rotation;
+    j = dr_dp * rotation->rotation;
   }
+}
+
+// The same residual with closed-form Jacobians (about 3x cheaper than auto-diff's dual numbers).
+// camera = (omega, t) of cam_from_world: p = R(omega) X + t, so dp/domega is d(R X)/d omega
+// (CameraRotation), dp/dt = I and dp/dX = R.
+template <int kDim>
+void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
+                        const double* point_world, double* residual, double* jac_camera,
+                        double* jac_point) {
+  double q[3];
+  ceres::AngleAxisRotatePoint(camera, point_world, q);
+  if (jac_camera == nullptr && jac_point == nullptr) {
+    ProjectRotated(r, q, camera + 3, point_world, nullptr, residual, nullptr, nullptr);
+    return;
+  }
+  const CameraRotation rotation(camera);
+  ProjectRotated(r, q, camera + 3, point_world, &rotation, residual, jac_camera, jac_point);
 }
 
 // Bundle adjustment cost with analytic Jacobians (parameter blocks: camera 6, point 3).

@@ -104,6 +104,8 @@ class SchurLm {
   std::vector<ProjectionResidual<3>> stereo_;
   size_t num_projections_ = 0;
   std::vector<Row> rows_;
+  std::vector<size_t> used_cameras_;
+  std::vector<CameraRotation> rotations_;  // per camera, at the point being evaluated
   std::vector<Block> blocks_;
   int reduced_size_ = 0;
   std::vector<size_t> free_points_;      // point index of each free point
@@ -230,6 +232,11 @@ void SchurLm::Build(const std::vector<bool>& skip, const std::vector<size_t>& no
     point_slot_begin_.push_back(point_slots_.size());
   }
 
+  std::vector<bool> camera_in_rows(num_cameras, false);
+  for (const Row& row : rows_) camera_in_rows[row.camera] = true;
+  for (size_t c = 0; c < num_cameras; ++c)
+    if (camera_in_rows[c]) used_cameras_.push_back(c);
+  rotations_.resize(num_cameras);
   lin_.resize(rows_.size());
   hpp_.resize(num_free_points);
   gp_.resize(num_free_points);
@@ -243,10 +250,12 @@ template <int kDim>
 double SchurLm::EvaluateProjectionRow(const Row& row, const ProjectionResidual<kDim>& model,
                                       const double* cameras, const double* points,
                                       Linearised* out) const {
+  const CameraRotation& rotation = rotations_[row.camera];
+  const double* point = points + 3 * row.point;
+  const Eigen::Vector3d q = rotation.rotation * Eigen::Map<const Eigen::Vector3d>(point);
   double r[kDim];
-  double* jc = out != nullptr ? out->camera : nullptr;
-  double* jp = out != nullptr ? out->point : nullptr;
-  EvaluateProjection(model, cameras + 6 * row.camera, points + 3 * row.point, r, jc, jp);
+  ProjectRotated(model, q.data(), cameras + 6 * row.camera + 3, point, &rotation, r,
+                 out != nullptr ? out->camera : nullptr, out != nullptr ? out->point : nullptr);
   double s = 0;
   for (int k = 0; k < kDim; ++k) s += r[k] * r[k];
   const Robust robust = Huber(s, kDim == 3 ? kChi2Stereo : kChi2Mono);
@@ -267,8 +276,8 @@ double SchurLm::EvaluatePlaneRow(const Row& row, const double* cameras, const do
   const double* point = points + 3 * row.point;
   const double* normal =
       row.normal >= 0 ? cameras + normals_offset_ + 3 * row.normal : d.normal_cam.data();
-  double q[3];
-  ceres::AngleAxisRotatePoint(camera, point, q);
+  const CameraRotation& rotation = rotations_[row.camera];
+  const Eigen::Vector3d q = rotation.rotation * Eigen::Map<const Eigen::Vector3d>(point);
   double along = 0;
   for (int k = 0; k < 3; ++k) along += normal[k] * (q[k] + camera[3 + k]);
   const double r = d.inv_sigma * (along - d.distance);
@@ -276,13 +285,11 @@ double SchurLm::EvaluatePlaneRow(const Row& row, const double* cameras, const do
   if (out == nullptr) return robust.rho;
   const double f = robust.factor;
   out->r[0] = f * r;
-  Eigen::Matrix3d rotation, dq_domega;
-  RotationDerivatives(camera, point, q, rotation, dq_domega);
   const Eigen::RowVector3d n = f * d.inv_sigma * Eigen::Map<const Eigen::RowVector3d>(normal);
   Eigen::Map<Eigen::Matrix<double, 1, 6>> jc(out->camera);
-  jc.leftCols<3>() = n * dq_domega;
+  jc.leftCols<3>() = n * rotation.DerivativeAt(point, q.data());
   jc.rightCols<3>() = n;
-  Eigen::Map<Eigen::RowVector3d>(out->point) = n * rotation;
+  Eigen::Map<Eigen::RowVector3d>(out->point) = n * rotation.rotation;
   if (row.normal >= 0) {
     Eigen::Matrix<double, 3, 2, Eigen::RowMajor> plus_jacobian;
     ceres::SphereManifold<3>().PlusJacobian(normal, plus_jacobian.data());
@@ -295,6 +302,8 @@ double SchurLm::EvaluatePlaneRow(const Row& row, const double* cameras, const do
 
 double SchurLm::Evaluate(const std::vector<double>& cameras, const std::vector<double>& points,
                          bool linearise) {
+  // Each camera's rotation once, not once per observation (a sine and cosine each).
+  for (size_t c : used_cameras_) rotations_[c] = CameraRotation(&cameras[6 * c]);
   double sum = 0;
   for (size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
@@ -384,20 +393,24 @@ bool SchurLm::ComputeStep(double radius) {
       for (size_t j = i; j < end; ++j) {
         const Block& bj = blocks_[point_slots_[j]];
         const Mat66 m = v.transpose() * w_[j];  // (A^-1 W_i)^T W_j = W_i^T A^-1 W_j
+        // Only the upper triangle: the Cholesky below reads nothing else.
         if (bi.size == 6 && bj.size == 6) {
-          reduced.block<6, 6>(bi.offset, bj.offset) -= m;
-          if (j != i) reduced.block<6, 6>(bj.offset, bi.offset) -= m.transpose();
-        } else {
+          if (bi.offset <= bj.offset) {
+            reduced.block<6, 6>(bi.offset, bj.offset) -= m;
+          } else {
+            reduced.block<6, 6>(bj.offset, bi.offset) -= m.transpose();
+          }
+        } else if (bi.offset <= bj.offset) {
           reduced.block(bi.offset, bj.offset, bi.size, bj.size) -=
               m.topLeftCorner(bi.size, bj.size);
-          if (j != i)
-            reduced.block(bj.offset, bi.offset, bj.size, bi.size) -=
-                m.topLeftCorner(bi.size, bj.size).transpose();
+        } else {
+          reduced.block(bj.offset, bi.offset, bj.size, bi.size) -=
+              m.topLeftCorner(bi.size, bj.size).transpose();
         }
       }
     }
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(reduced);
+  const Eigen::LLT<Eigen::MatrixXd, Eigen::Upper> llt(reduced);
   if (llt.info() != Eigen::Success) return false;
   step_f_ = llt.solve(rhs);
   if (!step_f_.allFinite()) return false;
