@@ -85,6 +85,8 @@ class SchurLm {
   double Evaluate(const std::vector<double>& cameras, const std::vector<double>& points,
                   bool linearise);
   void BuildNormalEquations();
+  template <int kDim>
+  void AccumulateRow(const Row& row, const Linearised& l);
   // The damped step for `radius`; false when a system is not positive definite.
   bool ComputeStep(double radius);
   double ModelCostChange() const;
@@ -323,6 +325,44 @@ double SchurLm::Evaluate(const std::vector<double>& cameras, const std::vector<d
   return 0.5 * sum;
 }
 
+template <int kDim>
+void SchurLm::AccumulateRow(const Row& row, const Linearised& l) {
+  using RowMatrix6 = Eigen::Matrix<double, kDim, 6, Eigen::RowMajor>;
+  using RowMatrix3 = Eigen::Matrix<double, kDim, 3, Eigen::RowMajor>;
+  const Eigen::Map<const Eigen::Matrix<double, kDim, 1>> r(l.r);
+  const Eigen::Map<const RowMatrix6> jc(l.camera);
+  const Eigen::Map<const RowMatrix3> jp(l.point);
+  const Eigen::Map<const Eigen::RowVector2d> jn(l.normal);
+  const int oc = row.camera_block >= 0 ? blocks_[row.camera_block].offset : -1;
+  const int on = row.normal_block >= 0 ? blocks_[row.normal_block].offset : -1;
+  if (oc >= 0) {
+    hff_.block<6, 6>(oc, oc).noalias() += jc.transpose() * jc;
+    gf_.segment<6>(oc).noalias() += jc.transpose() * r;
+  }
+  if constexpr (kDim == 1) {  // a plane row: its normal may be free
+    if (on >= 0) {
+      hff_.block<2, 2>(on, on).noalias() += jn.transpose() * jn;
+      gf_.segment<2>(on) += jn.transpose() * l.r[0];
+      if (oc >= 0) {
+        const Eigen::Matrix<double, 6, 2> cn = jc.transpose() * jn;
+        hff_.block<6, 2>(oc, on) += cn;
+        hff_.block<2, 6>(on, oc) += cn.transpose();
+      }
+    }
+  }
+  if (row.point_block >= 0) {
+    const size_t p = row.point_block;
+    hpp_[p].noalias() += jp.transpose() * jp;
+    gp_[p].noalias() += jp.transpose() * r;
+    const size_t first = point_slot_begin_[p];
+    if (oc >= 0) w_[first + row.camera_slot].noalias() += jp.transpose() * jc;
+    if constexpr (kDim == 1) {
+      if (on >= 0)
+        w_[first + row.normal_slot_in_point].leftCols<2>().noalias() += jp.transpose() * jn;
+    }
+  }
+}
+
 void SchurLm::BuildNormalEquations() {
   hff_.setZero(reduced_size_, reduced_size_);
   gf_.setZero(reduced_size_);
@@ -332,38 +372,16 @@ void SchurLm::BuildNormalEquations() {
   }
   for (Mat36& w : w_) w.setZero();
   for (size_t i = 0; i < rows_.size(); ++i) {
-    const Row& row = rows_[i];
-    const Linearised& l = lin_[i];
-    const int dim = row.Dim();
-    using RowMat3x6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor, 3, 6>;
-    using RowMat3x3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 3, 3>;
-    const Eigen::Map<const Eigen::VectorXd> r(l.r, dim);
-    const Eigen::Map<const RowMat3x6> jc(l.camera, dim, 6);
-    const Eigen::Map<const RowMat3x3> jp(l.point, dim, 3);
-    const Eigen::Map<const Eigen::RowVector2d> jn(l.normal);
-    const int oc = row.camera_block >= 0 ? blocks_[row.camera_block].offset : -1;
-    const int on = row.normal_block >= 0 ? blocks_[row.normal_block].offset : -1;
-    if (oc >= 0) {
-      hff_.block<6, 6>(oc, oc).noalias() += jc.transpose() * jc;
-      gf_.segment<6>(oc).noalias() += jc.transpose() * r;
-    }
-    if (on >= 0) {  // a plane row: one residual
-      hff_.block<2, 2>(on, on).noalias() += jn.transpose() * jn;
-      gf_.segment<2>(on) += jn.transpose() * l.r[0];
-      if (oc >= 0) {
-        const Eigen::Matrix<double, 6, 2> cn = jc.transpose() * jn;
-        hff_.block<6, 2>(oc, on) += cn;
-        hff_.block<2, 6>(on, oc) += cn.transpose();
-      }
-    }
-    if (row.point_block >= 0) {
-      const size_t p = row.point_block;
-      hpp_[p].noalias() += jp.transpose() * jp;
-      gp_[p].noalias() += jp.transpose() * r;
-      const size_t first = point_slot_begin_[p];
-      if (oc >= 0) w_[first + row.camera_slot].noalias() += jp.transpose() * jc;
-      if (on >= 0)
-        w_[first + row.normal_slot_in_point].leftCols<2>().noalias() += jp.transpose() * jn;
+    switch (rows_[i].kind) {
+      case Kind::kMono:
+        AccumulateRow<2>(rows_[i], lin_[i]);
+        break;
+      case Kind::kStereo:
+        AccumulateRow<3>(rows_[i], lin_[i]);
+        break;
+      case Kind::kPlane:
+        AccumulateRow<1>(rows_[i], lin_[i]);
+        break;
     }
   }
   if (!scaled_) {  // Ceres' Jacobi scaling, from the first Jacobian's column norms
