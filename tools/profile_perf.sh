@@ -18,7 +18,7 @@ cd "$here"
   --benchmark_report_aggregates_only=true | grep -E "median|^Benchmark"
 for v in analytic autodiff; do
   extra=()
-  [ "$v" = autodiff ] && extra=(--set mapping.ba_jacobians=autodiff --set optimizer.pose_jacobians=autodiff --set optimizer.pose_solver=ceres)
+  [ "$v" = autodiff ] && extra=(--set mapping.ba_jacobians=autodiff --set mapping.ba_solver=ceres --set optimizer.pose_jacobians=autodiff --set optimizer.pose_solver=ceres)
   /usr/bin/time -f "$v: wall %e s, user CPU %U s" "$build/bin/ademono" run \
     --dataset 7scenes:../shared/data/7scenes-seq-a --depth sensor --overwrite --out "$out/$v" "${extra[@]}" \
     >"$out/$v.log" 2>&1

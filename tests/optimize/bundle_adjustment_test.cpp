@@ -156,6 +156,9 @@ TEST(BundleAdjustmentTest, OptionsReadAndRejectUnknownChoices) {
   EXPECT_EQ(options.solver, BaSolver::kCeres);
   EXPECT_EQ(BundleAdjustmentOptions().solver, BaSolver::kLm);
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_solver: g2o}")));
+  // The built-in LM has analytic Jacobians only.
+  EXPECT_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_jacobians: autodiff}")),
+               std::invalid_argument);
   EXPECT_EQ(options.linear_solver, BaLinearSolver::kDenseSchur);
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_linear_solver: qr}")));
   EXPECT_ANY_THROW(ReadOptions<BundleAdjustmentOptions>(YAML::Load("{ba_jacobians: numeric}")));
@@ -375,6 +378,53 @@ TEST(BundleAdjustmentTest, LmSolverMatchesCeresWithHeldAndSolvedRoadNormals) {
     EXPECT_LT(MaxPointDifference(lm, ceres), 1e-5) << plane;
     EXPECT_NEAR(window.Scale(lm), window.Scale(ceres), 1e-6) << plane;
   }
+}
+
+// Windows with nothing but points free, or nothing but cameras, solve as Ceres does; a window
+// wider than the dense reduced system is meant for goes to Ceres whatever the option.
+TEST(BundleAdjustmentTest, LmSolverMatchesCeresWithOnlyPointsOrOnlyCamerasFree) {
+  std::mt19937 rng(14);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem points_only = MakeProblem(rng, &poses, &points);
+  for (BaCamera& c : points_only.cameras) c.fixed = true;
+  BundleAdjustmentProblem cameras_only = points_only;
+  for (BaCamera& c : cameras_only.cameras) c.fixed = false;
+  cameras_only.cameras[0].fixed = true;
+  cameras_only.points = points;
+  cameras_only.point_fixed.assign(points.size(), 1);
+  for (const BundleAdjustmentProblem* problem : {&points_only, &cameras_only}) {
+    const auto ceres = SolveWith(*problem, BaSolver::kCeres);
+    const auto lm = SolveWith(*problem, BaSolver::kLm);
+    EXPECT_EQ(lm.outlier, ceres.outlier);
+    EXPECT_LT(MaxCameraDifference(lm, ceres), 1e-7);
+    EXPECT_LT(MaxPointDifference(lm, ceres), 1e-6);
+  }
+  const auto moved = SolveWith(points_only, BaSolver::kLm);
+  EXPECT_GT(MaxPointDifference(moved, SolveWith(cameras_only, BaSolver::kLm)), 1e-3);
+}
+
+TEST(BundleAdjustmentTest, AWindowWiderThanTheDenseSystemGoesToCeres) {
+  std::mt19937 rng(15);
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> points;
+  BundleAdjustmentProblem problem = MakeProblem(rng, &poses, &points);
+  // 70 free copies of camera 1 with its observations: more than kMaxLmFreeCameras.
+  const size_t base = problem.observations.size();
+  for (size_t copy = 0; copy < 70; ++copy) {
+    problem.cameras.push_back(problem.cameras[1]);
+    for (size_t i = 0; i < base; ++i) {
+      if (problem.observations[i].camera != 1) continue;
+      BaObservation o = problem.observations[i];
+      o.camera = problem.cameras.size() - 1;
+      problem.observations.push_back(o);
+    }
+  }
+  ASSERT_GT(problem.cameras.size() - 1, BundleAdjustmentOptions::kMaxLmFreeCameras);
+  const auto ceres = SolveWith(problem, BaSolver::kCeres);
+  const auto lm = SolveWith(problem, BaSolver::kLm);
+  EXPECT_EQ(MaxCameraDifference(lm, ceres), 0.0);
+  EXPECT_EQ(MaxPointDifference(lm, ceres), 0.0);
 }
 
 // A real local BA (7-Scenes seq-a, 44 cameras, 1,871 points, 10,060 observations).

@@ -31,7 +31,11 @@ const OptionsTable<BundleAdjustmentOptions>& BundleAdjustmentOptions::Table() {
   return table;
 }
 
-void BundleAdjustmentOptions::Check() const { Table().CheckRanges(*this); }
+void BundleAdjustmentOptions::Check() const {
+  Table().CheckRanges(*this);
+  if (!analytic_jacobians && solver == BaSolver::kLm)
+    throw std::invalid_argument("mapping.ba_jacobians: autodiff needs mapping.ba_solver: ceres");
+}
 
 namespace {
 
