@@ -22,7 +22,7 @@ class OptionsTable;
 enum class BaLinearSolver { kSparseSchur, kDenseSchur, kIterativeSchur };
 
 // Who solves: the built-in Levenberg-Marquardt on a dense Schur complement (optimize/schur_lm.h:
-// Ceres' iteration at about a third of its cost on a local window), or Ceres with
+// Ceres' iteration at about a fifth of its cost on a local window), or Ceres with
 // `linear_solver`. The dense reduced system suits windows, so a problem with more than
 // kMaxLmFreeCameras free cameras goes to Ceres whatever the choice.
 enum class BaSolver { kLm, kCeres };
