@@ -133,13 +133,12 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
   const nlohmann::json s = nlohmann::json::parse(ReadText(out / "summary.json"));
   EXPECT_EQ(s["schema"], "ademono.run/1");
   EXPECT_EQ(Keys(s),
-            (std::set<std::string>{"schema",    "dataset",       "config",        "depth",
-                                   "detector",  "seed",          "deterministic", "filters",
-                                   "frames",    "partial",       "tracked",       "untracked",
-                                   "lost",
-                                   "keyframes", "map_points",    "wall_seconds",  "fps",
-                                   "timing",    "filter_counts", "accuracy",      "per_frame",
-                                   "loops",     "weak_poses",    "geometric_test"}));
+            (std::set<std::string>{"schema",    "dataset",   "config",        "depth",
+                                   "detector",  "seed",      "deterministic", "filters",
+                                   "frames",    "partial",   "tracked",       "untracked",
+                                   "lost",      "keyframes", "map_points",    "wall_seconds",
+                                   "fps",       "timing",    "filter_counts", "accuracy",
+                                   "per_frame", "loops",     "weak_poses",    "geometric_test"}));
   // A short xyz sequence revisits no place away from the live map: no loop.
   EXPECT_TRUE(s["loops"].is_array());
   EXPECT_TRUE(s["loops"].empty());
@@ -288,6 +287,12 @@ TEST_F(RunnerTest, DepthImagesAreDecodedOnlyForAProviderThatReadsThem) {
   ReadsNothing network;
   network.source = sequence.get();
   const RunReport without = RunSequence(*sequence, &network, nullptr, options);
+  EXPECT_FALSE(network.saw_depth);
+  RunOptions realtime = options;  // the real-time feed loads frames the same way
+  realtime.realtime = RealtimeOptions{};
+  realtime.realtime->pace = false;
+  realtime.realtime->queue = 100;
+  RunSequence(*sequence, &network, nullptr, realtime);
   EXPECT_FALSE(network.saw_depth);
   FrameDepth sensor;
   const RunReport with = RunSequence(*sequence, &sensor, nullptr, options);

@@ -39,10 +39,10 @@ void RealtimeFeed::Capture() {
         const double due = (frame->timestamp - *first_timestamp) / options_.speed;
         std::unique_lock<std::mutex> lock(mutex_);
         // Wakes early only to stop.
-        ready_.wait_until(lock,
-                          start + std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double>(due)),
-                          [this] { return stopping_; });
+        ready_.wait_until(
+            lock,
+            start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due)),
+            [this] { return stopping_; });
         if (stopping_) break;
       }
       std::lock_guard<std::mutex> lock(mutex_);
@@ -82,14 +82,15 @@ RealtimeStats RealtimeFeed::Stats() const {
 }
 
 std::unique_ptr<RealtimeFeed> MakeRealtimeFeed(const Sequence& sequence, size_t start, size_t end,
-                                               RealtimeOptions options) {
+                                               RealtimeOptions options, bool with_depth) {
   if (sequence.Kind() == "camera") options.pace = false;
   end = std::min(end, sequence.Size());
   auto next = std::make_shared<size_t>(start);
   return std::make_unique<RealtimeFeed>(
-      [&sequence, next, end]() -> std::optional<FrameData> {
+      [&sequence, next, end, with_depth]() -> std::optional<FrameData> {
         if (*next >= end) return std::nullopt;
-        return sequence.Load((*next)++);
+        const size_t i = (*next)++;
+        return with_depth ? sequence.Load(i) : sequence.LoadWithoutDepth(i);
       },
       options);
 }

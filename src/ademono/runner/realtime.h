@@ -61,8 +61,9 @@ class RealtimeFeed {
 };
 
 // A feed over frames [start, end) of `sequence`, paced by their timestamps unless the sequence
-// is a live camera (Kind() "camera"), which paces itself.
+// is a live camera (Kind() "camera"), which paces itself. Frames carry their depth images only
+// `with_depth` (a depth provider that reads them: DepthProvider::ReadsSequenceDepth).
 std::unique_ptr<RealtimeFeed> MakeRealtimeFeed(const Sequence& sequence, size_t start, size_t end,
-                                               RealtimeOptions options);
+                                               RealtimeOptions options, bool with_depth = true);
 
 }  // namespace ademono

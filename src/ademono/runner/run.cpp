@@ -175,7 +175,8 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   };
   std::unique_ptr<RealtimeFeed> feed;
   if (options.realtime) {
-    feed = MakeRealtimeFeed(sequence, pipeline.start, pipeline.end, *options.realtime);
+    feed = MakeRealtimeFeed(sequence, pipeline.start, pipeline.end, *options.realtime,
+                            depth != nullptr && depth->ReadsSequenceDepth());
     pipeline.feed = feed.get();
   }
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
@@ -310,10 +311,9 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     // scale it gave the depths is depth_scale).
     nlohmann::json per_keyframe = nlohmann::json::array();
     for (size_t k = 0; k < report.ground_heights.size(); ++k) {
-      per_keyframe.push_back({{"frame", k < report.ground_height_frames.size()
-                                            ? report.ground_height_frames[k]
-                                            : 0},
-                              {"height", report.ground_heights[k]}});
+      per_keyframe.push_back(
+          {{"frame", k < report.ground_height_frames.size() ? report.ground_height_frames[k] : 0},
+           {"height", report.ground_heights[k]}});
     }
     j["ground_scale"] = {{"camera_height", o.depth.camera_height},
                          {"estimates", report.ground_heights.size()},
