@@ -110,9 +110,7 @@ class SchurLm {
   std::vector<CameraRotation> rotations_;  // per camera, at the point being evaluated
   std::vector<Block> blocks_;
   int reduced_size_ = 0;
-  std::vector<size_t> free_points_;      // point index of each free point
-  std::vector<size_t> point_row_begin_;  // CSR over free points: rows touching the point
-  std::vector<size_t> point_rows_;
+  std::vector<size_t> free_points_;       // point index of each free point
   std::vector<size_t> point_slot_begin_;  // CSR: the blocks each free point couples to
   std::vector<int> point_slots_;
 
@@ -207,16 +205,16 @@ void SchurLm::Build(const std::vector<bool>& skip, const std::vector<size_t>& no
     add_row(row);
   }
 
-  // Rows and coupled blocks per free point, in row order.
+  // The rows of each free point (CSR, in row order), to number the blocks it couples to.
   const size_t num_free_points = free_points_.size();
-  point_row_begin_.assign(num_free_points + 1, 0);
+  std::vector<size_t> point_row_begin(num_free_points + 1, 0);
   for (const Row& row : rows_)
-    if (row.point_block >= 0) ++point_row_begin_[row.point_block + 1];
-  for (size_t p = 0; p < num_free_points; ++p) point_row_begin_[p + 1] += point_row_begin_[p];
-  point_rows_.resize(point_row_begin_.back());
-  std::vector<size_t> fill(point_row_begin_.begin(), point_row_begin_.end() - 1);
+    if (row.point_block >= 0) ++point_row_begin[row.point_block + 1];
+  for (size_t p = 0; p < num_free_points; ++p) point_row_begin[p + 1] += point_row_begin[p];
+  std::vector<size_t> point_rows(point_row_begin.back());
+  std::vector<size_t> fill(point_row_begin.begin(), point_row_begin.end() - 1);
   for (size_t r = 0; r < rows_.size(); ++r)
-    if (rows_[r].point_block >= 0) point_rows_[fill[rows_[r].point_block]++] = r;
+    if (rows_[r].point_block >= 0) point_rows[fill[rows_[r].point_block]++] = r;
   point_slot_begin_.assign(1, 0);
   for (size_t p = 0; p < num_free_points; ++p) {
     const size_t first_slot = point_slots_.size();
@@ -226,8 +224,8 @@ void SchurLm::Build(const std::vector<bool>& skip, const std::vector<size_t>& no
       point_slots_.push_back(block);
       return static_cast<int>(point_slots_.size() - 1 - first_slot);
     };
-    for (size_t k = point_row_begin_[p]; k < point_row_begin_[p + 1]; ++k) {
-      Row& row = rows_[point_rows_[k]];
+    for (size_t k = point_row_begin[p]; k < point_row_begin[p + 1]; ++k) {
+      Row& row = rows_[point_rows[k]];
       if (row.camera_block >= 0) row.camera_slot = slot_of(row.camera_block);
       if (row.normal_block >= 0) row.normal_slot_in_point = slot_of(row.normal_block);
     }

@@ -23,7 +23,8 @@ namespace ademono::internal {
 // angle-axis, translation), the shared road normals (3 each, on the unit sphere) at `normals`,
 // normal_slot[i] being plane distance i's, and points (3 each). A plane distance counts only
 // while some kept observation uses its camera and its point (as the Ceres path). Returns false
-// when nothing is left to solve or the start is not finite.
+// when nothing is left to solve, the start is not finite or 5 steps in a row were invalid (as
+// Ceres' FAILURE); the parameters are then the last accepted ones.
 bool SolveSchurLm(const BundleAdjustmentProblem& problem, const std::vector<bool>& skip,
                   int max_iterations, std::vector<double>& cameras, std::vector<double>& points,
                   double* normals, const std::vector<size_t>& normal_slot);

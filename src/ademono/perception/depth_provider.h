@@ -24,4 +24,9 @@ class DepthProvider {
   virtual bool ReadsSequenceDepth() const { return false; }
 };
 
+// Whether frames must be loaded with their depth images for `depth` (none: no provider).
+inline bool ReadsSequenceDepth(const DepthProvider* depth) {
+  return depth != nullptr && depth->ReadsSequenceDepth();
+}
+
 }  // namespace ademono

@@ -25,8 +25,8 @@ struct Prepared {
 // extraction (which needs only the image) runs on its own thread beside the depth network, and so
 // does the detector when there is a depth network too (the method's three parallel branches: two
 // single-threaded ONNX sessions on two cores); either way the result is the same.
-void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth,
-                   Detector* detector, const System& system, bool parallel) {
+void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth, Detector* detector,
+                   const System& system, bool parallel) {
   const double cpu_start = ThreadCpuMs();
   std::future<std::pair<ExtractedFrame, double>> features;
   std::future<double> detected;  // CPU ms; fills p.detections and p.detection_ms
@@ -78,8 +78,7 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
   const double cpu_start = ThreadCpuMs();
   const auto start = Now();
   // Depth images are decoded only for a provider that reads them (sensor, simulated).
-  const bool with_depth = depth != nullptr && depth->ReadsSequenceDepth();
-  p.frame = with_depth ? sequence.Load(i) : sequence.LoadWithoutDepth(i);
+  p.frame = ReadsSequenceDepth(depth) ? sequence.Load(i) : sequence.LoadWithoutDepth(i);
   p.decode_ms = MsSince(start);
   p.cpu_ms = p.decode_cpu_ms = ThreadCpuMs() - cpu_start;
   PrepareLoaded(p, sequence, depth, detector, system, parallel);

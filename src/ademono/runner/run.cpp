@@ -176,7 +176,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   std::unique_ptr<RealtimeFeed> feed;
   if (options.realtime) {
     feed = MakeRealtimeFeed(sequence, pipeline.start, pipeline.end, *options.realtime,
-                            depth != nullptr && depth->ReadsSequenceDepth());
+                            ReadsSequenceDepth(depth));
     pipeline.feed = feed.get();
   }
   const PipelineResult run = RunPipeline(sequence, depth, detector, system, pipeline);
