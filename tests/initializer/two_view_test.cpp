@@ -171,6 +171,16 @@ TEST(TwoViewTest, DeterministicForASeed) {
   ASSERT_TRUE(a.valid) << a.failure;
   EXPECT_EQ(a.cam2_from_cam1.matrix(), b.cam2_from_cam1.matrix());
   EXPECT_EQ(a.triangulated, b.triangulated);
+  // The two models' RANSAC on one thread after the other: the same models, scores and motion.
+  TwoViewOptions sequential;
+  sequential.parallel = false;
+  const TwoViewResult c = InitializeTwoView(TestK(), v.pixels1, v.pixels2, sequential);
+  EXPECT_EQ(a.H21, c.H21);
+  EXPECT_EQ(a.F21, c.F21);
+  EXPECT_EQ(a.score_homography, c.score_homography);
+  EXPECT_EQ(a.score_fundamental, c.score_fundamental);
+  EXPECT_EQ(a.cam2_from_cam1.matrix(), c.cam2_from_cam1.matrix());
+  EXPECT_EQ(a.triangulated, c.triangulated);
   // With 0.7 px noise the motion is still close.
   EXPECT_LT(RotationAngle(a.cam2_from_cam1.linear().transpose() *
                           Motion({0.02, 0.03, 0.0}, {0.3, 0.0, 0.1}).linear()),

@@ -7,7 +7,9 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <limits>
 #include <stdexcept>
+#include <thread>
 
 #include "ademono/core/options_table.h"
 #include "ademono/optimize/triangulation.h"
@@ -25,7 +27,8 @@ const OptionsTable<TwoViewOptions>& TwoViewOptions::Table() {
           .Add("min_triangulated", &T::min_triangulated, Range::AtLeast(8))
           .Add("min_triangulated_ratio", &T::min_triangulated_ratio, Range::Closed(0, 1))
           .Add("max_direction_sigma_deg", &T::max_direction_sigma_deg, Range::Above(0))
-          .Add("seed", &T::seed);
+          .Add("seed", &T::seed)
+          .Add("parallel", &T::parallel);
   return table;
 }
 
@@ -317,39 +320,75 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
   const Eigen::Matrix3d T2_inv = T2.inverse();
   const double inv_sigma2 = 1.0 / (options.sigma_px * options.sigma_px);
 
-  // The same minimal sets for both models, so that their scores compare.
+  // The same minimal sets for both models, so that their scores compare: drawn first, then each
+  // model's RANSAC runs on its own thread (as ORB-SLAM's), in iteration order, so the result does
+  // not depend on the threads.
   std::mt19937_64 rng(options.seed);
+  std::vector<std::array<size_t, 8>> sets(static_cast<size_t>(options.ransac_iterations));
   std::vector<size_t> all(n);
-  std::vector<Eigen::Vector2d> s1(8), s2(8);
-  std::vector<uint8_t> inliers_h, inliers_f, current;
-  double best_h = -1, best_f = -1;
-  for (int it = 0; it < options.ransac_iterations; ++it) {
+  for (auto& set : sets) {
     for (size_t i = 0; i < n; ++i) all[i] = i;
     // A partial Fisher-Yates shuffle: 8 distinct matches.
     for (size_t j = 0; j < 8; ++j) {
       std::uniform_int_distribution<size_t> pick(j, n - 1);
       std::swap(all[j], all[pick(rng)]);
-      s1[j] = n1[all[j]];
-      s2[j] = n2[all[j]];
+      set[j] = all[j];
     }
-    const Eigen::Matrix3d H = T2_inv * HomographyFromNormalized(s1, s2) * T1;
-    if (H.allFinite() && std::abs(H.determinant()) > 1e-15) {
-      const double score = ScoreHomography(H, pixels1, pixels2, inv_sigma2, &current);
-      if (score > best_h) {
-        best_h = score;
-        result.H21 = H;
-        inliers_h = current;
+  }
+  // Runs one model's RANSAC; `fit` gives the model in pixels (or a non-finite matrix), `score`
+  // its score and inliers.
+  auto ransac = [&](auto fit, auto score, Eigen::Matrix3d* model, std::vector<uint8_t>* inliers) {
+    std::vector<Eigen::Vector2d> s1(8), s2(8);
+    std::vector<uint8_t> current;
+    double best = -1;
+    for (const auto& set : sets) {
+      for (size_t j = 0; j < 8; ++j) {
+        s1[j] = n1[set[j]];
+        s2[j] = n2[set[j]];
+      }
+      const Eigen::Matrix3d m = fit(s1, s2);
+      if (!m.allFinite()) continue;
+      const double s = score(m, &current);
+      if (s > best) {
+        best = s;
+        *model = m;
+        *inliers = current;
       }
     }
-    const Eigen::Matrix3d F = T2.transpose() * FundamentalFromNormalized(s1, s2) * T1;
-    if (F.allFinite()) {
-      const double score = ScoreFundamental(F, pixels1, pixels2, inv_sigma2, &current);
-      if (score > best_f) {
-        best_f = score;
-        result.F21 = F;
-        inliers_f = current;
-      }
-    }
+    return best;
+  };
+  std::vector<uint8_t> inliers_h, inliers_f;
+  double best_h = -1, best_f = -1;
+  auto homography = [&] {
+    best_h = ransac(
+        [&](const auto& s1, const auto& s2) -> Eigen::Matrix3d {
+          const Eigen::Matrix3d H = T2_inv * HomographyFromNormalized(s1, s2) * T1;
+          if (!H.allFinite() || !(std::abs(H.determinant()) > 1e-15))
+            return Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+          return H;
+        },
+        [&](const Eigen::Matrix3d& H, std::vector<uint8_t>* current) {
+          return ScoreHomography(H, pixels1, pixels2, inv_sigma2, current);
+        },
+        &result.H21, &inliers_h);
+  };
+  auto fundamental = [&] {
+    best_f = ransac(
+        [&](const auto& s1, const auto& s2) -> Eigen::Matrix3d {
+          return T2.transpose() * FundamentalFromNormalized(s1, s2) * T1;
+        },
+        [&](const Eigen::Matrix3d& F, std::vector<uint8_t>* current) {
+          return ScoreFundamental(F, pixels1, pixels2, inv_sigma2, current);
+        },
+        &result.F21, &inliers_f);
+  };
+  if (options.parallel) {
+    std::thread homography_thread(homography);
+    fundamental();
+    homography_thread.join();
+  } else {
+    homography();
+    fundamental();
   }
   result.score_homography = std::max(0.0, best_h);
   result.score_fundamental = std::max(0.0, best_f);
