@@ -15,7 +15,8 @@
 # (prefetch: decode, depth, detection, ORB extraction and keypoint depths of frame k+1 while
 # frame k is tracked; tracking: filters, tracking, mapping's structure and merges; mapping: the
 # BA solve). "tracking thread" is the tracking thread's own CPU time per frame (median), decode
-# and the on_frame output excluded; "prefetch thread" the same for the prefetch work.
+# and the on_frame output excluded; "prefetch thread" the same for the prefetch work. A third
+# table sums the per-frame records over the run (where the time goes in total).
 # Usage: tools/bench_throughput.sh [--out DIR] [--frames A:B] [--no-network] [-- RUN_ARGS...]
 # Measure on an idle machine: other jobs inflate every figure.
 set -euo pipefail
@@ -81,4 +82,19 @@ for c, s in runs.items():
     t = s["timing"]
     cells = [f"{t[k]['median_ms']:.2f} ({t[k]['thread']})" for k in stages]
     print(f"| {c} | " + " | ".join(cells) + " |")
+# Where a run's time goes in total: medians hide the keyframes. Sums over summary.json's
+# per-frame records, in seconds: the tracking and prefetch threads' CPU, the tracking thread's
+# wait for the prefetch, and local mapping (wall: each keyframe's structure step on the tracking
+# thread plus its BA on the mapping thread, which overlaps the frames after it).
+print()
+print("Run totals, seconds (sums of summary.json per_frame[].ms):")
+print()
+totals = [("tracking thread CPU", "tracking_thread_cpu"), ("prefetch thread CPU", "prefetch_thread_cpu"),
+          ("tracking", "tracking"), ("prefetch wait", "prefetch_wait"), ("local mapping (wall)", "mapping")]
+print("| case | wall | " + " | ".join(name for name, _ in totals) + " |")
+print("|---|---|" + "---|" * len(totals))
+for c, s in runs.items():
+    frames = s["per_frame"]
+    sums = [sum(f["ms"].get(key, 0.0) for f in frames) / 1e3 for _, key in totals]
+    print(f"| {c} | {s['wall_seconds']:.1f} | " + " | ".join(f"{v:.2f}" for v in sums) + " |")
 PY
