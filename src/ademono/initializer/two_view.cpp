@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <random>
+#include <future>
 #include <limits>
+#include <random>
 #include <stdexcept>
-#include <thread>
 
 #include "ademono/core/options_table.h"
 #include "ademono/optimize/triangulation.h"
@@ -383,9 +383,10 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
         &result.F21, &inliers_f);
   };
   if (options.parallel) {
-    std::thread homography_thread(homography);
+    // std::async: an exception on the other thread reaches this one at get().
+    std::future<void> homography_done = std::async(std::launch::async, homography);
     fundamental();
-    homography_thread.join();
+    homography_done.get();
   } else {
     homography();
     fundamental();
