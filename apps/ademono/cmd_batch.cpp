@@ -16,6 +16,7 @@
 #include "ademono/batch/tasks.h"
 #include "ademono/core/error.h"
 #include "command.h"
+#include "stop_signals.h"
 
 namespace fs = std::filesystem;
 
@@ -36,28 +37,6 @@ void Say(const std::string& line) { std::cerr << "ademono batch: " << line << st
 // (runs write partial outputs, which the next batch redoes), then the table of what is done.
 std::atomic<int> g_stop{0};
 extern "C" void OnBatchStopSignal(int signo) { g_stop.store(signo); }
-
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction action {};
-    action.sa_handler = OnBatchStopSignal;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = 0;  // no SA_RESTART: waitpid returns to look at the flag
-    sigaction(SIGINT, &action, &old_int_);
-    sigaction(SIGTERM, &action, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-};
 
 // Writes the tables and the report; lists what is not done. 0 when every run is done.
 int Collect(const batch::Batch& b, const std::set<std::string>& in_flight) {
@@ -155,7 +134,8 @@ int RunBatch(const BatchArgs& args) {
     const int jobs = args.jobs > 0 ? args.jobs : plan.jobs > 0 ? plan.jobs : batch::DefaultJobs();
     if (!tasks.empty()) {
       Say("local engine, " + std::to_string(jobs) + " at a time");
-      const StopSignals signals;
+      // No SA_RESTART: waitpid returns to look at the flag.
+      const StopSignals signals(OnBatchStopSignal, 0);
       batch::RunLocal(tasks, jobs, Say, &g_stop);
     }
     const int collected = Collect(b, {});

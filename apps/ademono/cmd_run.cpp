@@ -34,6 +34,7 @@
 #include "ademono/slam/system.h"
 #include "command.h"
 #include "run_options.h"
+#include "stop_signals.h"
 
 namespace fs = std::filesystem;
 
@@ -66,28 +67,6 @@ extern "C" void OnStopSignal(int signo) {
   g_stop_signal = signo;
   g_stop.store(true);
 }
-
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction action {};
-    action.sa_handler = OnStopSignal;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &action, &old_int_);
-    sigaction(SIGTERM, &action, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-};
 
 // --live-trajectory: DIR/trajectory.live.tum gets one line per tracked frame (its pose when it was
 // tracked, before later refinement), each fsynced, for a robot reading the run as it goes.
@@ -245,7 +224,7 @@ int Run(const RunArgs& args) {
   g_stop.store(false);
   run.pipeline.stop = &g_stop;
   std::optional<StopSignals> signals;
-  signals.emplace();
+  signals.emplace(OnStopSignal, SA_RESETHAND);
   if (live_server && args.live_wait_clients > 0) {
     std::fprintf(stderr, "ademono run: waiting for %zu live client(s)\n", args.live_wait_clients);
     live_server->WaitForClients(args.live_wait_clients, &g_stop);
