@@ -25,4 +25,11 @@ double RotationAngle(const Eigen::Matrix3d& rotation);
 Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& omega);
 Eigen::Vector3d LogSO3(const Eigen::Matrix3d& rotation);
 
+// The cross-product matrix: Skew(a) * b = a x b.
+inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
 }  // namespace ademono

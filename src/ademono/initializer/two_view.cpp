@@ -475,11 +475,6 @@ double TranslationDirectionSigmaDeg(const Eigen::Matrix3d& K, const Rigid3d& cam
     J << K(0, 0) / z, 0, -K(0, 0) * p.x() / z2, 0, K(1, 1) / z, -K(1, 1) * p.y() / z2;
     return J;
   };
-  auto skew = [](const Eigen::Vector3d& v) {
-    Eigen::Matrix3d m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-  };
   // Pose parameters: rotation (left perturbation, 3) and the translation's direction (2).
   Eigen::Matrix<double, 5, 5> schur = Eigen::Matrix<double, 5, 5>::Zero();
   const double w = 1.0 / (sigma_px * sigma_px);
@@ -490,7 +485,7 @@ double TranslationDirectionSigmaDeg(const Eigen::Matrix3d& K, const Rigid3d& cam
     if (!(x.z() > 0) || !(p2.z() > 0)) continue;
     const Eigen::Matrix<double, 2, 3> P1 = projection_jacobian(x), P2 = projection_jacobian(p2);
     Eigen::Matrix<double, 2, 5> Jc;
-    Jc.leftCols<3>() = -P2 * skew(R * x);
+    Jc.leftCols<3>() = -P2 * Skew(R * x);
     Jc.rightCols<2>() = P2 * B;
     const Eigen::Matrix<double, 2, 3> Jx2 = P2 * R;
     const Eigen::Matrix3d Hxx = w * (P1.transpose() * P1 + Jx2.transpose() * Jx2);

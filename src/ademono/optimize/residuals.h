@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ademono/core/geometry.h"
 #include "ademono/optimize/optimizer_types.h"
 
 namespace ademono::internal {
@@ -101,11 +102,6 @@ struct CameraRotation {
   bool small = false;
 
   CameraRotation() = default;
-  static Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-    Eigen::Matrix3d m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-  }
   explicit CameraRotation(const double* camera) {
     using Mat3 = Eigen::Matrix3d;
     const Eigen::Map<const Eigen::Vector3d> omega(camera);

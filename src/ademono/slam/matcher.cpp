@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <opencv2/features2d.hpp>
 
+#include "ademono/core/geometry.h"
 #include "ademono/feature/line_search_grid.h"
 #include "ademono/feature/orb_extractor.h"
 
@@ -321,8 +322,7 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
   const Rigid3d cam2_from_cam1 = k2.cam_from_world * k1.cam_from_world.inverse();
   const Eigen::Matrix3d R = cam2_from_cam1.linear();
   const Eigen::Vector3d t = cam2_from_cam1.translation();
-  Eigen::Matrix3d tx;
-  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  const Eigen::Matrix3d tx = Skew(t);
   auto inverse_k = [](const PinholeIntrinsics& in) {
     Eigen::Matrix3d k_inv = Eigen::Matrix3d::Identity();
     k_inv(0, 0) = 1.0 / in.fx;
