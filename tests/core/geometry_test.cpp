@@ -13,6 +13,15 @@ TEST(Geometry, ExpLogRoundTrip) {
   EXPECT_NEAR(RotationAngle(ExpSO3(omega)), omega.norm(), 1e-12);
 }
 
+TEST(Geometry, SkewIsTheCrossProductAndItsExpIsTheRotation) {
+  const Eigen::Vector3d a(0.3, -1.2, 2.5), b(-0.7, 0.4, 1.1);
+  EXPECT_NEAR((Skew(a) * b - a.cross(b)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((Skew(a).transpose() + Skew(a)).norm(), 0.0, 0.0);  // antisymmetric
+  // First order: exp(w) ~ I + [w]x for a small w.
+  const Eigen::Vector3d w = 1e-6 * a;
+  EXPECT_NEAR((ExpSO3(w) - (Eigen::Matrix3d::Identity() + Skew(w))).norm(), 0.0, 1e-11);
+}
+
 TEST(Geometry, MakeRigidFromMatrixOrthonormalises) {
   Eigen::Matrix<double, 3, 4> m;
   m << 1.0001, 0, 0, 1, 0, 1, 0, 2, 0, 0, 0.9999, 3;
