@@ -7,7 +7,7 @@
 #include <array>
 #include <cmath>
 #include <future>
-#include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
@@ -335,8 +335,8 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
       set[j] = all[j];
     }
   }
-  // Runs one model's RANSAC; `fit` gives the model in pixels (or a non-finite matrix), `score`
-  // its score and inliers.
+  // Runs one model's RANSAC; `fit` gives the model in pixels (none for a degenerate set),
+  // `score` its score and inliers.
   auto ransac = [&](auto fit, auto score, Eigen::Matrix3d* model, std::vector<uint8_t>* inliers) {
     std::vector<Eigen::Vector2d> s1(8), s2(8);
     std::vector<uint8_t> current;
@@ -346,12 +346,12 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
         s1[j] = n1[set[j]];
         s2[j] = n2[set[j]];
       }
-      const Eigen::Matrix3d m = fit(s1, s2);
-      if (!m.allFinite()) continue;
-      const double s = score(m, &current);
+      const std::optional<Eigen::Matrix3d> m = fit(s1, s2);
+      if (!m) continue;
+      const double s = score(*m, &current);
       if (s > best) {
         best = s;
-        *model = m;
+        *model = *m;
         *inliers = current;
       }
     }
@@ -361,10 +361,9 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
   double best_h = -1, best_f = -1;
   auto homography = [&] {
     best_h = ransac(
-        [&](const auto& s1, const auto& s2) -> Eigen::Matrix3d {
+        [&](const auto& s1, const auto& s2) -> std::optional<Eigen::Matrix3d> {
           const Eigen::Matrix3d H = T2_inv * HomographyFromNormalized(s1, s2) * T1;
-          if (!H.allFinite() || !(std::abs(H.determinant()) > 1e-15))
-            return Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+          if (!H.allFinite() || !(std::abs(H.determinant()) > 1e-15)) return std::nullopt;
           return H;
         },
         [&](const Eigen::Matrix3d& H, std::vector<uint8_t>* current) {
@@ -374,8 +373,10 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
   };
   auto fundamental = [&] {
     best_f = ransac(
-        [&](const auto& s1, const auto& s2) -> Eigen::Matrix3d {
-          return T2.transpose() * FundamentalFromNormalized(s1, s2) * T1;
+        [&](const auto& s1, const auto& s2) -> std::optional<Eigen::Matrix3d> {
+          const Eigen::Matrix3d F = T2.transpose() * FundamentalFromNormalized(s1, s2) * T1;
+          if (!F.allFinite()) return std::nullopt;
+          return F;
         },
         [&](const Eigen::Matrix3d& F, std::vector<uint8_t>* current) {
           return ScoreFundamental(F, pixels1, pixels2, inv_sigma2, current);
