@@ -3,7 +3,9 @@
 # runs `ademono run` once per case, one after the other on the same binary, and prints wall
 # frames/s, keyframes, ATE se3, tracked frames and the per-frame stage medians (ms) from each
 # run's summary.json. Cases (extra arguments go to every run):
-#   default       configs/7scenes.yaml as shipped (concurrent mapping, fixed hand-off)
+#   default       configs/7scenes.yaml as shipped (concurrent mapping, fixed hand-off, frames
+#                 k+1 and k+2 prepared at once)
+#   prefetch1     --prefetch-frames 1: only frame k+1 prepared while k is tracked (same outputs)
 #   synchronous   --set mapping.handoff_frames=0 (BA merged before the next frame, old default)
 #   inline        --set mapping.threaded=false (same schedule, BA solved on the tracking thread:
 #                 same outputs as default, shows what the mapping thread buys)
@@ -46,8 +48,9 @@ run_case() {
   "$bin" run --overwrite "${common[@]}" "$@" "${extra[@]}" --out "$out/$name" > "$out/$name.log" 2>&1 ||
     { echo "bench_throughput: case $name failed, see $out/$name.log" >&2; exit 1; }
 }
-cases=(default synchronous inline no-prefetch none)
+cases=(default prefetch1 synchronous inline no-prefetch none)
 run_case default
+run_case prefetch1 --prefetch-frames 1
 run_case synchronous --set mapping.handoff_frames=0
 run_case inline --set mapping.threaded=false
 run_case no-prefetch --no-overlap

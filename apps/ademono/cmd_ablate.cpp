@@ -73,7 +73,7 @@ int Ablate(const AblateArgs& args) {
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &options.pipeline.start, &options.pipeline.end);
   options.pipeline.overlap = !args.no_overlap;
-  options.pipeline.prefetch_frames = PrefetchFrames(args);
+  options.pipeline.prefetch_frames = args.prefetch_frames;
 
   DepthFactoryContext context;
   context.sequence = sequence.get();

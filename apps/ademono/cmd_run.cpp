@@ -156,7 +156,7 @@ int Run(const RunArgs& args) {
   if (!args.frames.empty())
     ParseFrames(args.frames, sequence->Size(), &run.pipeline.start, &run.pipeline.end);
   run.pipeline.overlap = !args.no_overlap;
-  run.pipeline.prefetch_frames = PrefetchFrames(args);
+  run.pipeline.prefetch_frames = args.prefetch_frames;
   run.load_map = args.load_map;
   run.localize_only = args.localize_only;
   run.save_map = args.save_map;

@@ -32,19 +32,14 @@ void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args) {
   app.add_flag("--no-overlap", args.no_overlap,
                "compute depth/detections sequentially (no prefetch)");
   app.add_option("--prefetch-frames", args.prefetch_frames,
-                 "frames prepared ahead at once (default: 2 with --depth model:, else 1)")
-      ->check(CLI::Range(0, 8));
+                 "frames prepared ahead at once, on both cores (default: 2)")
+      ->check(CLI::Range(1, 8));
   app.add_option("--viz", args.viz, "write per-frame images with filter labels into DIR");
   app.add_option("--camera", args.camera, "camera YAML (overrides the dataset's)");
   app.add_option("--set", args.set,
                  "override a config key: SECTION.KEY=VALUE (repeatable), e.g. "
                  "--set depth.scale_correction=false");
   app.add_option("--out", args.out, "output directory")->required();
-}
-
-int PrefetchFrames(const SequenceRunArgs& args) {
-  if (args.prefetch_frames > 0) return args.prefetch_frames;
-  return args.depth.rfind("model:", 0) == 0 ? 2 : 1;
 }
 
 fs::path FindConfigDir() {

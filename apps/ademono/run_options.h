@@ -26,7 +26,7 @@ struct SequenceRunArgs {
   std::string frames;
   std::string seed;  // empty: the config's filter.seed and initializer.seed
   bool no_overlap = false;
-  int prefetch_frames = 0;  // 0: 2 with a depth network (model:), else 1
+  int prefetch_frames = 2;
   std::string viz;
   std::string camera;
   std::string out;
@@ -35,9 +35,6 @@ struct SequenceRunArgs {
 // --dataset --config --depth --detector --frames --seed --no-overlap --prefetch-frames --viz
 // --camera --out.
 void AddSequenceRunOptions(CLI::App& app, SequenceRunArgs& args);
-// --prefetch-frames, or its default for the depth source: a network slower than tracking
-// (model:) gets two frames prepared at once, on both cores (runner/pipeline.h).
-int PrefetchFrames(const SequenceRunArgs& args);
 
 // Where the dataset-family configs live: $ADEMONO_CONFIG_DIR, ./configs, or the source tree the
 // binary was built from (bin/ is build/<name>/bin). Empty when none is found.
