@@ -448,5 +448,34 @@ TEST(VideoTest, ReadsFramesInAnyOrderAndCountsThem) {
                InputError);
 }
 
+// The pipeline's workers (two by default) may ask for frame k+2 just before k+1: the recently
+// decoded frames answer that without reopening the file, which would decode it again from the
+// start. The file is moved away after the first loads, so a reopen would fail here.
+TEST(VideoTest, WorkersAskingSlightlyOutOfOrderNeverReopenTheFile) {
+  const fs::path dir = MakeTempDir();
+  const fs::path file = dir / "clip.avi";
+  constexpr int kFrames = 24;
+  {
+    cv::VideoWriter writer(file.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 15.0,
+                           cv::Size(kW, kH));
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < kFrames; ++i)
+      writer.write(cv::Mat(kH, kW, CV_8UC3, cv::Scalar(i * 10, 0, 0)));
+  }
+  WriteCamera(dir / "cam.yaml");
+  const auto seq = OpenSequence("video:" + file.string(), dir / "cam.yaml");
+  auto blue = [&](size_t i) {
+    return static_cast<int>(seq->Load(i).image.at<cv::Vec3b>(10, 10)[0]);
+  };
+  EXPECT_NEAR(blue(0), 0, 6);
+  fs::rename(file, dir / "moved.avi");
+  // Pairs swapped, as two workers may take them, then a jump ahead and a look back within it.
+  for (size_t i : {2u, 1u, 4u, 3u, 6u, 5u, 7u, 15u, 12u, 13u, 14u, 16u, 10u}) {
+    EXPECT_NEAR(blue(i), static_cast<int>(i) * 10, 6) << i;
+  }
+  // Further back than the recent frames needs the file again.
+  EXPECT_THAT(ExpectInputError([&] { seq->Load(0); }), HasSubstr("cannot open as a video"));
+}
+
 }  // namespace
 }  // namespace ademono

@@ -1,11 +1,14 @@
 // A video file read with cv::VideoCapture. The frame count and timestamps (index / fps) are
 // established once at open by grabbing through the file, because container frame counts are
 // often wrong. Decoding is sequential: the capture is kept at the next frame so in-order Load()
-// costs one decode; going backwards reopens the file. A mutex serialises access to the capture.
+// costs one decode, and the last few decoded frames are kept, so that the pipeline's workers,
+// which may ask for k+2 just before k+1, never send it back; going further back reopens the
+// file. A mutex serialises access to the capture.
 // Also the live camera (camera:N), read through the same OpenCV capture.
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
@@ -54,29 +57,22 @@ class VideoSequence : public Sequence {
   FrameData Load(size_t i) const override {
     if (i >= Size()) throw std::out_of_range("video frame index out of range");
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!(cached_index_ && *cached_index_ == i)) {
+    const cv::Mat* image = Recent(i);
+    if (image == nullptr) {
       if (i < next_index_) Reopen();
-      while (next_index_ < i) {
+      // Frames that could not be asked for again are only grabbed, the last kRecent decoded.
+      while (next_index_ + kRecent <= i) {
         if (!capture_.grab()) ThrowDecodeError(next_index_);
         ++next_index_;
       }
-      cv::Mat image;
-      if (!capture_.read(image) || image.empty()) ThrowDecodeError(i);
-      ++next_index_;
-      cached_ = ToBgr8(image, file_);
-      cached_index_ = i;
-      if (cached_.cols != camera_.width || cached_.rows != camera_.height) {
-        ThrowInputError(file_, "frames are " + std::to_string(cached_.cols) + "x" +
-                                   std::to_string(cached_.rows) + ", the camera is " +
-                                   std::to_string(camera_.width) + "x" +
-                                   std::to_string(camera_.height));
-      }
+      while (next_index_ <= i) Decode();
+      image = Recent(i);
     }
     FrameData frame;
     frame.index = i;
     frame.timestamp = timestamps_[i];
     frame.name = "frame-" + std::to_string(i);
-    frame.image = cached_.clone();
+    frame.image = image->clone();
     return frame;
   }
 
@@ -87,7 +83,27 @@ class VideoSequence : public Sequence {
     const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
     if (!capture_.open(file_.string(), api)) ThrowInputError(file_, "cannot open as a video");
     next_index_ = 0;
-    cached_index_.reset();
+    recent_.clear();
+  }
+  const cv::Mat* Recent(size_t i) const {
+    for (const auto& [index, image] : recent_) {
+      if (index == i) return &image;
+    }
+    return nullptr;
+  }
+  // Reads frame next_index_ into the recent frames.
+  void Decode() const {
+    cv::Mat image;
+    if (!capture_.read(image) || image.empty()) ThrowDecodeError(next_index_);
+    cv::Mat bgr = ToBgr8(image, file_);
+    if (bgr.cols != camera_.width || bgr.rows != camera_.height) {
+      ThrowInputError(file_, "frames are " + std::to_string(bgr.cols) + "x" +
+                                 std::to_string(bgr.rows) + ", the camera is " +
+                                 std::to_string(camera_.width) + "x" +
+                                 std::to_string(camera_.height));
+    }
+    if (recent_.size() == kRecent) recent_.pop_front();
+    recent_.emplace_back(next_index_++, std::move(bgr));
   }
   [[noreturn]] void ThrowDecodeError(size_t i) const {
     ThrowInputError(file_, "frame " + std::to_string(i) + " does not decode");
@@ -99,8 +115,9 @@ class VideoSequence : public Sequence {
   mutable std::mutex mutex_;
   mutable cv::VideoCapture capture_;
   mutable size_t next_index_ = 0;
-  mutable std::optional<size_t> cached_index_;
-  mutable cv::Mat cached_;
+  // More than the pipeline's workers can ask for out of order (--prefetch-frames at most 8).
+  static constexpr size_t kRecent = 8;
+  mutable std::deque<std::pair<size_t, cv::Mat>> recent_;
 };
 
 // A live camera. Frames are read in order by the real-time feed's capture thread; there is no
