@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "ademono 0.1.0");
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
 
   auto& commands = ademono::cli::Commands();
   std::sort(commands.begin(), commands.end(),
@@ -25,7 +26,14 @@ int main(int argc, char** argv) {
     runners.emplace_back(sub, command.setup(*sub));
   }
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // Bad arguments are bad input: one line and exit code 2, as every other input error.
+    std::cerr << "ademono: error: " << e.what() << " (--help lists the options)\n";
+    return 2;
+  }
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::set_pattern("[%l] %v");
 

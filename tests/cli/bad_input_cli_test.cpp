@@ -91,6 +91,17 @@ class BadInputCliTest : public testing::Test {
   fs::path dir_, out_;
 };
 
+// Arguments the parser rejects are bad input too: one line naming the option, exit code 2.
+TEST_F(BadInputCliTest, ArgumentsOutOfRangeOrUnknown) {
+  const fs::path folder = MakeFolder(3);
+  ExpectRunFails("--dataset folder:" + folder.string() + " --prefetch-frames 0",
+                 "--prefetch-frames: Value 0 not in range 1 to 8");
+  ExpectRunFails("--dataset folder:" + folder.string() + " --no-such-flag", "--no-such-flag");
+  ExpectBadInput("--log-level loud run --dataset folder:" + folder.string() + " --out " +
+                     out_.string(),
+                 "--log-level", out_ / "trajectory.tum");
+}
+
 TEST_F(BadInputCliTest, DepthModelsOfTheWrongShapeTypeOrOpset) {
   const fs::path folder = MakeFolder(3);
   const fs::path image = folder / "000000.png";
