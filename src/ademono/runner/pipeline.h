@@ -27,8 +27,8 @@ struct PipelineOptions {
   // With overlap: how many frames ahead are prepared at once (1: frame k+1 while k is tracked).
   // At 1 the preparation (decode and ORB, or a depth network) bounds the rate and leaves a core
   // idle; at 2 the preparations of k+1 and k+2 overlap on both cores (seq-a with sensor depth
-  // 51 -> 79 frames/s). Same outputs for any value (each frame's preparation is a pure function
-  // of the frame; tracking still takes them in order).
+  // 47.5 -> 75.4 frames/s, tools/bench_throughput.sh). Same outputs for any value (each frame's
+  // preparation is a pure function of the frame; tracking still takes them in order).
   int prefetch_frames = 2;
   // Set from elsewhere (a SIGINT handler): the loop stops before the next frame; the frames done
   // so far stay valid (PipelineResult::stopped).
