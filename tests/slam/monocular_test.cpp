@@ -121,9 +121,11 @@ TEST(MonocularTest, GeometryAloneIsWithinTwiceExactDepth) {
   const double none_sim3 = Ate(none, Alignment::kSim3).ape.rmse;
   RecordProperty("exact_sim3_um", static_cast<int>(exact_sim3 * 1e6));
   RecordProperty("none_sim3_um", static_cast<int>(none_sim3 * 1e6));
-  // Measured: 4.5 mm against 2.7 mm (1.67x; issue 28 asks 1.5x), and 7.6 mm before frames
-  // followed the keyframes around them (tracking.interpolate_trajectory). Without depth the
-  // map's scale drifts, which one sim3 scale cannot take out; with depth every frame measures it.
+  // Measured: 4.5 mm against 2.7 mm (1.67x; issue 28 asks 1.5x, which the acceptance table's
+  // office with walking persons meets: 0.93x, tests/cli/geometric_cli_test.cpp), and 7.6 mm
+  // before frames followed the keyframes around them (tracking.interpolate_trajectory). Without
+  // depth the map's scale drifts, which one sim3 scale cannot take out; with depth every frame
+  // measures it.
   EXPECT_LE(none_sim3, 2.0 * exact_sim3) << "exact " << exact_sim3 << " none " << none_sim3;
   EXPECT_LE(none_sim3, 0.01) << "metres, at the sim3 scale";
 
