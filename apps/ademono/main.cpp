@@ -15,7 +15,14 @@ int main(int argc, char** argv) {
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
       ->capture_default_str()
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+      // Whatever spdlog reads (it also takes "warning" and "err"); anything else it would
+      // silently turn into "off".
+      ->check([](const std::string& level) {
+        return level == "off" || spdlog::level::from_str(level) != spdlog::level::off
+                   ? std::string()
+                   : "unknown level '" + level +
+                         "' (trace, debug, info, warn, error, critical, off)";
+      });
 
   auto& commands = ademono::cli::Commands();
   std::sort(commands.begin(), commands.end(),

@@ -100,6 +100,11 @@ TEST_F(BadInputCliTest, ArgumentsOutOfRangeOrUnknown) {
   ExpectBadInput("--log-level loud run --dataset folder:" + folder.string() + " --out " +
                      out_.string(),
                  "--log-level", out_ / "trajectory.tum");
+  // Every name spdlog reads stays valid ("warning" as well as "warn").
+  EXPECT_EQ(RunCli("--log-level warning synth --scene office --frames 2 --out " +
+                   (dir_ / "warning").string())
+                .code,
+            0);
 }
 
 TEST_F(BadInputCliTest, DepthModelsOfTheWrongShapeTypeOrOpset) {
