@@ -426,6 +426,119 @@ TEST(RemoveDynamicPointsTest, WithoutBackgroundDepthStageOneFallsBackToThePaperT
   EXPECT_EQ(r.labels[ForwardScene::kParked1], PointLabel::kDynamicStage1);
 }
 
+// The epipolar test needs no depth: every depth of the forward scene removed, the previous frame
+// at the origin and this frame's prediction off the true motion by 0.5 degrees of yaw and a
+// translation 5 degrees off its direction (the refinement on the background takes both out).
+struct EpipolarForwardScene : ForwardScene {
+  EpipolarForwardScene() {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (auto& x : previous.points_cam) x = Eigen::Vector3d(nan, nan, nan);
+    for (float& z : cur_depths) z = -1.f;
+    previous.cam_from_world = Rigid3d::Identity();
+    prediction = cur_from_prev;
+    prediction.linear() = ExpSO3(Eigen::Vector3d(0, 0.5 * M_PI / 180, 0));
+    prediction.translation() = Eigen::Vector3d(0.5 * std::sin(5 * M_PI / 180), 0,
+                                               -0.5 * std::cos(5 * M_PI / 180));
+  }
+  DynamicInput Input() const {
+    DynamicInput in = ForwardScene::Input();
+    in.predicted_cam_from_world = prediction;
+    return in;
+  }
+  std::vector<Eigen::Vector2d> Background(bool current) const {
+    std::vector<Eigen::Vector2d> px;
+    for (size_t i = kBoxCount; i < cur.size(); ++i) {
+      const cv::Point2f& p = current ? cur[i].pt : prev[i].pt;
+      px.emplace_back(p.x, p.y);
+    }
+    return px;
+  }
+  Rigid3d prediction = Rigid3d::Identity();
+};
+
+DynamicParams EpipolarParams() {
+  DynamicParams p = ForwardParams();
+  p.dynamic_test = "epipolar";
+  return p;
+}
+
+TEST(EpipolarTest, DistanceFromTheLineOfTheMotionsFundamentalMatrix) {
+  const Camera camera = TestCamera();
+  Rigid3d cur_from_prev = Rigid3d::Identity();
+  cur_from_prev.translation() = Eigen::Vector3d(-0.3, 0, 0);  // sideways: horizontal lines
+  const Eigen::Matrix3d f = FundamentalFromMotion(cur_from_prev, camera);
+  const Eigen::Vector3d x = camera.Unproject(Eigen::Vector2d(100, 200), 4.0);
+  const Eigen::Vector2d a = camera.Project(x), b = camera.Project(cur_from_prev * x);
+  EXPECT_NEAR(EpipolarDistance(f, a, b), 0.0, 1e-9);
+  EXPECT_NEAR(EpipolarDistance(f, a, b + Eigen::Vector2d(0, 3)), 3.0, 1e-9);
+  EXPECT_NEAR(EpipolarDistance(f, a, b + Eigen::Vector2d(40, 0)), 0.0, 1e-9);  // along the line
+  // The translation's length does not matter.
+  cur_from_prev.translation() *= 7;
+  EXPECT_NEAR(EpipolarDistance(FundamentalFromMotion(cur_from_prev, camera), a,
+                               b + Eigen::Vector2d(0, 3)),
+              3.0, 1e-9);
+}
+
+TEST(EpipolarTest, TheMotionIsRefinedOnTheBackground) {
+  const EpipolarForwardScene s;
+  const Rigid3d refined = RefineMotionOnBackground(s.prediction, s.Background(false),
+                                                   s.Background(true), s.camera, 2.0);
+  EXPECT_LT((refined.linear() - s.cur_from_prev.linear()).norm(), 1e-6);
+  EXPECT_LT((refined.translation().normalized() - s.cur_from_prev.translation().normalized())
+                .norm(),
+            1e-6);
+  EXPECT_NEAR(refined.translation().norm(), s.prediction.translation().norm(), 1e-12);
+  // Too few points: the prediction comes back unchanged.
+  const std::vector<Eigen::Vector2d> few(7, Eigen::Vector2d(1, 1));
+  EXPECT_TRUE(RefineMotionOnBackground(s.prediction, few, few, s.camera, 2.0)
+                  .isApprox(s.prediction, 0.0));
+}
+
+TEST(RemoveDynamicPointsTest, TheEpipolarTestKeepsParkedCarsWithoutAnyDepth) {
+  const EpipolarForwardScene s;
+  const DynamicResult r = RemoveDynamicPoints(s.Input(), EpipolarParams());
+  EXPECT_TRUE(r.epipolar_fitted);
+  EXPECT_FALSE(r.background_motion.has_value());  // the depth test did not run
+  EXPECT_EQ(r.labels[ForwardScene::kParked1], PointLabel::kKept);
+  EXPECT_EQ(r.labels[ForwardScene::kParked2], PointLabel::kKept);
+  EXPECT_EQ(r.labels[ForwardScene::kParkedNoPrevDepth], PointLabel::kKept);
+  EXPECT_EQ(r.labels[ForwardScene::kNoDepth], PointLabel::kKept);
+  // Both movers leave their epipolar lines (by 4.8 and 15 px).
+  EXPECT_EQ(r.labels[ForwardScene::kMoving], PointLabel::kDynamicStage1);
+  EXPECT_EQ(r.labels[ForwardScene::kMovingNoPrevDepth], PointLabel::kDynamicStage1);
+  for (size_t i = ForwardScene::kBoxCount; i < s.cur.size(); ++i)
+    EXPECT_EQ(r.labels[i], PointLabel::kKept);
+  // The unrefined prediction would have judged the parked car moving: the refinement matters.
+  EpipolarForwardScene unrefined = s;
+  unrefined.previous.cam_from_world.reset();  // no motion: the fundamental matrix is fitted
+  const DynamicResult fitted = RemoveDynamicPoints(unrefined.Input(), EpipolarParams());
+  EXPECT_TRUE(fitted.epipolar_fitted);
+  EXPECT_EQ(fitted.num_motion_inliers, 24);
+  const Eigen::Matrix3d predicted = FundamentalFromMotion(s.prediction, s.camera);
+  const cv::Point2f a = s.prev[ForwardScene::kParked1].pt, b = s.cur[ForwardScene::kParked1].pt;
+  EXPECT_GT(EpipolarDistance(predicted, Eigen::Vector2d(a.x, a.y), Eigen::Vector2d(b.x, b.y)),
+            2.0);
+}
+
+TEST(RemoveDynamicPointsTest, TheEpipolarBoxVoteWeighsTheBackgroundsOwnFailures) {
+  // 2 of the box's 5 judged points failed (40 %, above box_vote_ratio 0.3): with a clean
+  // background the box moves and its unjudged point goes with it. With a quarter of the
+  // background mismatched, 2 of 5 is what a static box shows too, and the point stays.
+  EpipolarForwardScene s;
+  DynamicParams p = EpipolarParams();
+  p.box_vote_ratio = 0.3;
+  p.box_vote_min_matches = 5;
+  s.previous.keypoints[ForwardScene::kNoDepth] = cv::KeyPoint();  // unmatched: no verdict
+  s.previous.descriptors.row(ForwardScene::kNoDepth).setTo(0);
+  s.cur_desc.row(ForwardScene::kNoDepth).setTo(255);
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[ForwardScene::kNoDepth],
+            PointLabel::kDynamicBoxVote);
+  // Six background points matched to the wrong previous keypoint (30 px to the side).
+  for (size_t i = ForwardScene::kBoxCount; i < ForwardScene::kBoxCount + 6; ++i)
+    s.previous.keypoints[i].pt.x += 30;
+  EXPECT_EQ(RemoveDynamicPoints(s.Input(), p).labels[ForwardScene::kNoDepth], PointLabel::kKept);
+}
+
 TEST(RemoveDynamicPointsTest, NoDetectionsKeepsEverythingAndBadInputThrows) {
   Scene s;
   s.detections.clear();

@@ -58,6 +58,13 @@ TEST(FilterOptionsTest, FromYamlAndCheck) {
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_min_inliers: 3}")),
                std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_inlier_px: 0}")), std::invalid_argument);
+  EXPECT_EQ(FilterOptions{}.dynamic.dynamic_test, "depth");
+  const FilterOptions epipolar =
+      FilterOptions::FromYaml(YAML::Load("{dynamic_test: epipolar, epipolar_px: 1.5}"));
+  EXPECT_EQ(epipolar.dynamic.dynamic_test, "epipolar");
+  EXPECT_DOUBLE_EQ(epipolar.dynamic.epipolar_px, 1.5);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{dynamic_test: flow}")), std::invalid_argument);
+  EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{epipolar_px: 0}")), std::invalid_argument);
   EXPECT_THROW(FilterOptions::FromYaml(YAML::Load("{motion_ransac_iterations: 0}")),
                std::invalid_argument);
   try {

@@ -61,8 +61,33 @@ struct DynamicResult {
   std::optional<Eigen::Vector2d> background_motion;
   int num_background_matches = 0;   // used for background_motion (<= t)
   bool motion_compensated = false;  // stage 1 used the fitted camera motion
-  int num_motion_inliers = 0;       // RANSAC inliers of that fit
+  int num_motion_inliers = 0;       // RANSAC inliers of that fit (or of the epipolar one)
+  bool epipolar_fitted = false;     // `dynamic_test: epipolar` found the background's geometry
 };
+
+// The fundamental matrix (undistorted pixels, previous to current: x_cur^T F x_prev = 0) fitted to
+// the matches whose current point is outside every box, RANSAC at params.epipolar_px. nullopt
+// with fewer than params.motion_min_inliers matches or inliers.
+std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
+    const std::vector<cv::KeyPoint>& keypoints, const PreviousFrameFeatures& previous,
+    const std::vector<cv::DMatch>& matches, const std::vector<char>& in_box, const Camera& camera,
+    const DynamicParams& params, int* num_inliers = nullptr);
+
+// The motion from the previous to the current camera, from `cur_from_prev` (a prediction) refined
+// on background correspondences (undistorted pixels) by Gauss-Newton on their Sampson distances,
+// Huber at `threshold_px`, points beyond three times it ignored. Rotation and the translation's
+// direction only: the translation keeps its length. Unchanged with fewer than 8 points.
+Rigid3d RefineMotionOnBackground(const Rigid3d& cur_from_prev,
+                                 const std::vector<Eigen::Vector2d>& prev_px,
+                                 const std::vector<Eigen::Vector2d>& cur_px, const Camera& camera,
+                                 double threshold_px);
+
+// F = K^-T [t]x R K^-1 of the motion (undistorted pixels, previous to current).
+Eigen::Matrix3d FundamentalFromMotion(const Rigid3d& cur_from_prev, const Camera& camera);
+
+// Distance (pixels) of the current point from the epipolar line of its previous match.
+double EpipolarDistance(const Eigen::Matrix3d& fundamental, const Eigen::Vector2d& prev_px,
+                        const Eigen::Vector2d& cur_px);
 
 DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams& params);
 

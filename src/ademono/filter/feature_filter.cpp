@@ -55,11 +55,17 @@ const OptionsTable<DynamicParams>& DynamicParams::Table() {
           .Add("dynamic_class_ids", &P::dynamic_class_ids)
           .Add("motion_min_inliers", &P::motion_min_inliers, Range::AtLeast(4))
           .Add("motion_inlier_px", &P::motion_inlier_px, Range::Above(0))
-          .Add("motion_ransac_iterations", &P::motion_ransac_iterations, Range::AtLeast(1));
+          .Add("motion_ransac_iterations", &P::motion_ransac_iterations, Range::AtLeast(1))
+          .Add("dynamic_test", &P::dynamic_test)
+          .Add("epipolar_px", &P::epipolar_px, Range::Above(0));
   return table;
 }
 
-void DynamicParams::Check() const { Table().CheckRanges(*this); }
+void DynamicParams::Check() const {
+  Table().CheckRanges(*this);
+  Require(dynamic_test == "depth" || dynamic_test == "epipolar",
+          "dynamic_test must be 'depth' or 'epipolar', got '" + dynamic_test + "'");
+}
 
 const OptionsTable<FilterOptions>& FilterOptions::Table() {
   using F = FilterOptions;
@@ -82,6 +88,7 @@ const OptionsTable<FilterOptions>& FilterOptions::Table() {
 
 void FilterOptions::Check() const {
   Table().CheckRanges(*this);
+  dynamic.Check();
   Require(std::isfinite(enhancement_p_percent) && enhancement_p_percent != 0,
           "enhancement_p_percent must be > 0 (or < 0 for the default), got " +
               std::to_string(enhancement_p_percent));
@@ -152,7 +159,7 @@ std::vector<PointLabel> FeatureFilter::Apply(const FilterInput& input, FilterSta
     for (size_t i = 0; i < n; ++i)
       if (labels[i] == PointLabel::kKept) labels[i] = result.labels[i];
     for (const GrownBox& b : result.boxes) (b.small ? s.boxes_small : s.boxes_large)++;
-    s.stage1_ran = result.background_motion.has_value() ? 1 : 0;
+    s.stage1_ran = result.background_motion.has_value() || result.epipolar_fitted ? 1 : 0;
     s.stage1_compensated = s.stage1_ran && result.motion_compensated ? 1 : 0;
   }
 

@@ -83,6 +83,8 @@ struct PreviousFrameFeatures {
   // Position of each keypoint in that frame's camera, from its depth alone (known even when the
   // frame was not tracked); NaN if no depth. Empty: stage 1 cannot compensate the camera motion.
   std::vector<Eigen::Vector3d> points_cam;
+  // That frame's estimated pose, if it was tracked (the epipolar test's motion).
+  std::optional<Rigid3d> cam_from_world;
 };
 
 struct FilterInput {

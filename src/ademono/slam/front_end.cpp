@@ -123,6 +123,7 @@ void FrontEnd::Remember(const ExtractedFrame& extracted,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   previous.points_world.assign(keypoints.size(), Eigen::Vector3d(nan, nan, nan));
   previous.points_cam.assign(keypoints.size(), Eigen::Vector3d(nan, nan, nan));
+  previous.cam_from_world = cam_from_world;
   const Rigid3d world_from_cam = cam_from_world ? cam_from_world->inverse() : Rigid3d::Identity();
   for (size_t i = 0; i < keypoints.size(); ++i) {
     if (!(extracted.depths[i] > 0)) continue;
