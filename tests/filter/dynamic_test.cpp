@@ -437,8 +437,8 @@ struct EpipolarForwardScene : ForwardScene {
     previous.cam_from_world = Rigid3d::Identity();
     prediction = cur_from_prev;
     prediction.linear() = ExpSO3(Eigen::Vector3d(0, 0.5 * M_PI / 180, 0));
-    prediction.translation() = Eigen::Vector3d(0.5 * std::sin(5 * M_PI / 180), 0,
-                                               -0.5 * std::cos(5 * M_PI / 180));
+    prediction.translation() =
+        Eigen::Vector3d(0.5 * std::sin(5 * M_PI / 180), 0, -0.5 * std::cos(5 * M_PI / 180));
   }
   DynamicInput Input() const {
     DynamicInput in = ForwardScene::Input();
@@ -474,9 +474,9 @@ TEST(EpipolarTest, DistanceFromTheLineOfTheMotionsFundamentalMatrix) {
   EXPECT_NEAR(EpipolarDistance(f, a, b + Eigen::Vector2d(40, 0)), 0.0, 1e-9);  // along the line
   // The translation's length does not matter.
   cur_from_prev.translation() *= 7;
-  EXPECT_NEAR(EpipolarDistance(FundamentalFromMotion(cur_from_prev, camera), a,
-                               b + Eigen::Vector2d(0, 3)),
-              3.0, 1e-9);
+  EXPECT_NEAR(
+      EpipolarDistance(FundamentalFromMotion(cur_from_prev, camera), a, b + Eigen::Vector2d(0, 3)),
+      3.0, 1e-9);
 }
 
 TEST(EpipolarTest, TheMotionIsRefinedOnTheBackground) {
@@ -484,14 +484,14 @@ TEST(EpipolarTest, TheMotionIsRefinedOnTheBackground) {
   const Rigid3d refined = RefineMotionOnBackground(s.prediction, s.Background(false),
                                                    s.Background(true), s.camera, 2.0);
   EXPECT_LT((refined.linear() - s.cur_from_prev.linear()).norm(), 1e-6);
-  EXPECT_LT((refined.translation().normalized() - s.cur_from_prev.translation().normalized())
-                .norm(),
-            1e-6);
+  EXPECT_LT(
+      (refined.translation().normalized() - s.cur_from_prev.translation().normalized()).norm(),
+      1e-6);
   EXPECT_NEAR(refined.translation().norm(), s.prediction.translation().norm(), 1e-12);
   // Too few points: the prediction comes back unchanged.
   const std::vector<Eigen::Vector2d> few(7, Eigen::Vector2d(1, 1));
-  EXPECT_TRUE(RefineMotionOnBackground(s.prediction, few, few, s.camera, 2.0)
-                  .isApprox(s.prediction, 0.0));
+  EXPECT_TRUE(
+      RefineMotionOnBackground(s.prediction, few, few, s.camera, 2.0).isApprox(s.prediction, 0.0));
 }
 
 TEST(RemoveDynamicPointsTest, TheEpipolarTestKeepsParkedCarsWithoutAnyDepth) {
@@ -516,8 +516,7 @@ TEST(RemoveDynamicPointsTest, TheEpipolarTestKeepsParkedCarsWithoutAnyDepth) {
   EXPECT_EQ(fitted.num_motion_inliers, 24);
   const Eigen::Matrix3d predicted = FundamentalFromMotion(s.prediction, s.camera);
   const cv::Point2f a = s.prev[ForwardScene::kParked1].pt, b = s.cur[ForwardScene::kParked1].pt;
-  EXPECT_GT(EpipolarDistance(predicted, Eigen::Vector2d(a.x, a.y), Eigen::Vector2d(b.x, b.y)),
-            2.0);
+  EXPECT_GT(EpipolarDistance(predicted, Eigen::Vector2d(a.x, a.y), Eigen::Vector2d(b.x, b.y)), 2.0);
 }
 
 TEST(RemoveDynamicPointsTest, TheEpipolarBoxVoteWeighsTheBackgroundsOwnFailures) {

@@ -1,6 +1,7 @@
 #include "ademono/filter/dynamic.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
@@ -86,6 +87,22 @@ std::optional<Rigid3d> FitBackgroundMotion(const std::vector<cv::KeyPoint>& keyp
   return cur_from_prev;
 }
 
+namespace {
+
+// The undistorted pixels of a current keypoint and its previous match; nullopt if either is NaN.
+std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> UndistortedMatch(
+    const std::vector<cv::KeyPoint>& keypoints, const PreviousFrameFeatures& previous, size_t i,
+    int j, const Camera& camera) {
+  const cv::Point2f& p = keypoints[i].pt;
+  const cv::Point2f& q = previous.keypoints[static_cast<size_t>(j)].pt;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y))
+    return std::nullopt;
+  return std::make_pair(camera.Undistort(Eigen::Vector2d(q.x, q.y)),
+                        camera.Undistort(Eigen::Vector2d(p.x, p.y)));
+}
+
+}  // namespace
+
 std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
     const std::vector<cv::KeyPoint>& keypoints, const PreviousFrameFeatures& previous,
     const std::vector<cv::DMatch>& matches, const std::vector<char>& in_box, const Camera& camera,
@@ -94,21 +111,19 @@ std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
   for (const cv::DMatch& m : matches) {
     const size_t i = static_cast<size_t>(m.queryIdx);
     if (in_box[i]) continue;
-    const cv::Point2f& p = keypoints[i].pt;
-    const cv::Point2f& q = previous.keypoints[static_cast<size_t>(m.trainIdx)].pt;
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y))
-      continue;
-    const Eigen::Vector2d a = camera.Undistort(Eigen::Vector2d(q.x, q.y));
-    const Eigen::Vector2d b = camera.Undistort(Eigen::Vector2d(p.x, p.y));
+    const auto match = UndistortedMatch(keypoints, previous, i, m.trainIdx, camera);
+    if (!match) continue;
+    const auto& [a, b] = *match;
     prev_px.emplace_back(static_cast<float>(a.x()), static_cast<float>(a.y()));
     cur_px.emplace_back(static_cast<float>(b.x()), static_cast<float>(b.y()));
   }
-  if (static_cast<int>(prev_px.size()) < std::max(8, params.motion_min_inliers)) return std::nullopt;
+  if (static_cast<int>(prev_px.size()) < std::max(8, params.motion_min_inliers))
+    return std::nullopt;
   // OpenCV's RANSAC seeds its own generator with a constant: deterministic for the same input.
   // 1000 iterations at most (OpenCV's default), fewer once 99 % confidence is reached.
   cv::Mat mask;
-  const cv::Mat f = cv::findFundamentalMat(prev_px, cur_px, cv::FM_RANSAC, params.epipolar_px,
-                                           0.99, 1000, mask);
+  const cv::Mat f =
+      cv::findFundamentalMat(prev_px, cur_px, cv::FM_RANSAC, params.epipolar_px, 0.99, 1000, mask);
   if (f.rows != 3 || f.cols != 3) return std::nullopt;
   const int inliers = cv::countNonZero(mask);
   if (inliers < params.motion_min_inliers) return std::nullopt;
@@ -122,8 +137,8 @@ std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
 
 Eigen::Matrix3d FundamentalFromMotion(const Rigid3d& cur_from_prev, const Camera& camera) {
   Eigen::Matrix3d k_inv;
-  k_inv << 1 / camera.fx, 0, -camera.cx / camera.fx, 0, 1 / camera.fy, -camera.cy / camera.fy, 0,
-      0, 1;
+  k_inv << 1 / camera.fx, 0, -camera.cx / camera.fx, 0, 1 / camera.fy, -camera.cy / camera.fy, 0, 0,
+      1;
   // Only the translation's direction matters; unit length keeps the line's scale sane.
   const Eigen::Vector3d t = cur_from_prev.translation();
   const Eigen::Vector3d direction = t.norm() > 0 ? Eigen::Vector3d(t.normalized()) : t;
@@ -149,8 +164,8 @@ Rigid3d RefineMotionOnBackground(const Rigid3d& cur_from_prev,
   const double f = 0.5 * (camera.fx + camera.fy);
   std::vector<Eigen::Vector3d> a, b;
   for (size_t k = 0; k < prev_px.size(); ++k) {
-    a.emplace_back((prev_px[k].x() - camera.cx) / camera.fx, (prev_px[k].y() - camera.cy) / camera.fy,
-                   1.0);
+    a.emplace_back((prev_px[k].x() - camera.cx) / camera.fx,
+                   (prev_px[k].y() - camera.cy) / camera.fy, 1.0);
     b.emplace_back((cur_px[k].x() - camera.cx) / camera.fx, (cur_px[k].y() - camera.cy) / camera.fy,
                    1.0);
   }
@@ -171,9 +186,21 @@ Rigid3d RefineMotionOnBackground(const Rigid3d& cur_from_prev,
     *t = (direction + tangent(direction) * delta.tail<2>()).normalized();
   };
   for (int iteration = 0; iteration < 10; ++iteration) {
+    // Central differences: the ten perturbed essential matrices are the same for every point.
+    const Eigen::Matrix3d e = Skew(direction) * rotation;
+    std::array<Eigen::Matrix3d, 10> perturbed;
+    for (int p = 0; p < 5; ++p) {
+      for (int sign = 0; sign < 2; ++sign) {
+        Eigen::Matrix<double, 5, 1> step = Eigen::Matrix<double, 5, 1>::Zero();
+        step(p) = sign == 0 ? 1e-6 : -1e-6;
+        Eigen::Matrix3d r;
+        Eigen::Vector3d t;
+        apply(step, &r, &t);
+        perturbed[static_cast<size_t>(2 * p + sign)] = Skew(t) * r;
+      }
+    }
     Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
     Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
-    const Eigen::Matrix3d e = Skew(direction) * rotation;
     for (size_t k = 0; k < a.size(); ++k) {
       const double r = f * SampsonNormalised(e, a[k], b[k]);
       // Huber weights at the threshold, nothing beyond three: the background has mismatches and
@@ -182,20 +209,16 @@ Rigid3d RefineMotionOnBackground(const Rigid3d& cur_from_prev,
       const double w = std::abs(r) <= threshold_px ? 1.0 : threshold_px / std::abs(r);
       Eigen::Matrix<double, 1, 5> jac;
       for (int p = 0; p < 5; ++p) {
-        Eigen::Matrix<double, 5, 1> step = Eigen::Matrix<double, 5, 1>::Zero();
-        step(p) = 1e-6;
-        Eigen::Matrix3d rp, rm;
-        Eigen::Vector3d tp, tm;
-        apply(step, &rp, &tp);
-        apply(-step, &rm, &tm);
-        jac(p) = f * (SampsonNormalised(Skew(tp) * rp, a[k], b[k]) -
-                      SampsonNormalised(Skew(tm) * rm, a[k], b[k])) /
+        jac(p) = f *
+                 (SampsonNormalised(perturbed[static_cast<size_t>(2 * p)], a[k], b[k]) -
+                  SampsonNormalised(perturbed[static_cast<size_t>(2 * p + 1)], a[k], b[k])) /
                  2e-6;
       }
       h += w * jac.transpose() * jac;
       g += w * jac.transpose() * r;
     }
-    const Eigen::Matrix<double, 5, 1> delta = -(h + 1e-6 * Eigen::Matrix<double, 5, 5>::Identity()).ldlt().solve(g);
+    const Eigen::Matrix<double, 5, 1> delta =
+        -(h + 1e-6 * Eigen::Matrix<double, 5, 5>::Identity()).ldlt().solve(g);
     if (!delta.allFinite()) break;
     Eigen::Matrix3d r;
     Eigen::Vector3d t;
@@ -305,29 +328,24 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
       std::vector<Eigen::Vector2d> background_prev, background_cur;
       for (const cv::DMatch& m : matches) {
         const size_t i = static_cast<size_t>(m.queryIdx);
-        const cv::Point2f& p = kps[i].pt;
-        const cv::Point2f& q = prev.keypoints[static_cast<size_t>(m.trainIdx)].pt;
-        if (in_any[i] || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) ||
-            !std::isfinite(q.y))
-          continue;
-        background_prev.push_back(input.camera->Undistort(Eigen::Vector2d(q.x, q.y)));
-        background_cur.push_back(input.camera->Undistort(Eigen::Vector2d(p.x, p.y)));
+        if (in_any[i]) continue;
+        if (const auto match = UndistortedMatch(kps, prev, i, m.trainIdx, *input.camera)) {
+          background_prev.push_back(match->first);
+          background_cur.push_back(match->second);
+        }
       }
       cur_from_prev = RefineMotionOnBackground(cur_from_prev, background_prev, background_cur,
                                                *input.camera, params.epipolar_px);
       fundamental = FundamentalFromMotion(cur_from_prev, *input.camera);
     } else {
-      fundamental = FitBackgroundEpipolarGeometry(kps, prev, matches, in_any, *input.camera,
-                                                  params, &result.num_motion_inliers);
+      fundamental = FitBackgroundEpipolarGeometry(kps, prev, matches, in_any, *input.camera, params,
+                                                  &result.num_motion_inliers);
     }
     result.epipolar_fitted = fundamental.has_value();
     auto distance = [&](size_t i, int j) -> std::optional<double> {
-      const cv::Point2f& p = kps[i].pt;
-      const cv::Point2f& q = prev.keypoints[static_cast<size_t>(j)].pt;
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y))
-        return std::nullopt;
-      return EpipolarDistance(*fundamental, input.camera->Undistort(Eigen::Vector2d(q.x, q.y)),
-                              input.camera->Undistort(Eigen::Vector2d(p.x, p.y)));
+      const auto match = UndistortedMatch(kps, prev, i, j, *input.camera);
+      if (!match) return std::nullopt;
+      return EpipolarDistance(*fundamental, match->first, match->second);
     };
     // The background's own share beyond the threshold (mismatches, the prediction's error): a box
     // is moving only when its share clearly exceeds it (the box vote below).
@@ -475,9 +493,9 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
         // body): a box moves only when its failures exceed the background's share by three
         // binomial standard deviations (KITTI 00: the background's share is about 8 % at 2 px).
         const double p = background_failure, judged_points = num_judged;
-        moving_box[b] = moving_box[b] &&
-                        num_dynamic > judged_points * p +
-                                          3.0 * std::sqrt(judged_points * p * (1 - p));
+        moving_box[b] =
+            moving_box[b] &&
+            num_dynamic > judged_points * p + 3.0 * std::sqrt(judged_points * p * (1 - p));
       }
       if (moving_box[b] && failed_depths.size() >= 3) {
         const auto mid =

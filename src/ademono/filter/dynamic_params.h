@@ -30,12 +30,12 @@ struct DynamicParams {
   double motion_inlier_px = 3.0;  // RANSAC reprojection threshold of the fit
   int motion_ransac_iterations = 100;
   // How stage 1 judges a large box's point. "depth": against the camera motion and the depths
-  // above, then stage 2 against the predicted pose (what the paper's tests need). "epipolar":
-  // against the fundamental matrix fitted to the background's matches (RANSAC), by the point's
-  // distance from its epipolar line; no depth and no pose prediction, so a network's depth error
-  // cannot fail a static point (outdoors at 10 m/s it failed 30-96 % of the background around
-  // parked cars, docs/kitti.md). A mover along its epipolar line (a car ahead in the same lane)
-  // passes; stage 2 is not run.
+  // above, then stage 2 against the predicted pose (what the paper's tests need). "epipolar": by
+  // the point's distance from its epipolar line under the camera's motion (the pose prediction
+  // refined on the background's matches; without poses a fundamental matrix fitted to them), so
+  // no depth: a network's depth error cannot fail a static point (outdoors at 10 m/s it failed
+  // 30-96 % of the background around parked cars, docs/kitti.md). A mover along its epipolar
+  // line (a car ahead in the same lane) passes; stage 2 is not run.
   std::string dynamic_test = "depth";
   double epipolar_px = 2.0;  // RANSAC threshold of the fit and the test's (pixels)
   // Box vote for large-box points without a stage-1/2 verdict: a box is moving when at least this
