@@ -64,8 +64,7 @@ std::optional<Rigid3d> FitBackgroundMotion(const std::vector<cv::KeyPoint>& keyp
     image.emplace_back(static_cast<float>(un.x()), static_cast<float>(un.y()));
   }
   if (static_cast<int>(object.size()) < params.motion_min_inliers) return std::nullopt;
-  const cv::Mat K =
-      (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  const cv::Mat K = camera.KMat();
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
   // OpenCV's RANSAC seeds its own generator with a constant: deterministic for the same input.
@@ -104,18 +103,15 @@ std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> UndistortedMatch(
 }  // namespace
 
 std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
-    const std::vector<cv::KeyPoint>& keypoints, const PreviousFrameFeatures& previous,
-    const std::vector<cv::DMatch>& matches, const std::vector<char>& in_box, const Camera& camera,
-    const DynamicParams& params, int* num_inliers) {
+    const std::vector<Eigen::Vector2d>& background_prev,
+    const std::vector<Eigen::Vector2d>& background_cur, const DynamicParams& params,
+    int* num_inliers) {
   std::vector<cv::Point2f> prev_px, cur_px;
-  for (const cv::DMatch& m : matches) {
-    const size_t i = static_cast<size_t>(m.queryIdx);
-    if (in_box[i]) continue;
-    const auto match = UndistortedMatch(keypoints, previous, i, m.trainIdx, camera);
-    if (!match) continue;
-    const auto& [a, b] = *match;
-    prev_px.emplace_back(static_cast<float>(a.x()), static_cast<float>(a.y()));
-    cur_px.emplace_back(static_cast<float>(b.x()), static_cast<float>(b.y()));
+  for (size_t k = 0; k < background_prev.size(); ++k) {
+    prev_px.emplace_back(static_cast<float>(background_prev[k].x()),
+                         static_cast<float>(background_prev[k].y()));
+    cur_px.emplace_back(static_cast<float>(background_cur[k].x()),
+                        static_cast<float>(background_cur[k].y()));
   }
   if (static_cast<int>(prev_px.size()) < std::max(8, params.motion_min_inliers))
     return std::nullopt;
@@ -320,53 +316,49 @@ DynamicResult RemoveDynamicPoints(const DynamicInput& input, const DynamicParams
     // background. The fit alone misjudged KITTI's near parked cars: its matches are mostly far,
     // nearly a rotation, and their fundamental matrix is loose at the image's sides (frames
     // 80 / 160, box points beyond 2 px: 71 / 100 % against 10 / 18 % under the true motion).
+    std::vector<Eigen::Vector2d> background_prev, background_cur;
+    for (const cv::DMatch& m : matches) {
+      const size_t i = static_cast<size_t>(m.queryIdx);
+      if (in_any[i]) continue;
+      if (const auto match = UndistortedMatch(kps, prev, i, m.trainIdx, *input.camera)) {
+        background_prev.push_back(match->first);
+        background_cur.push_back(match->second);
+      }
+    }
     std::optional<Eigen::Matrix3d> fundamental;
     if (input.predicted_cam_from_world && prev.cam_from_world) {
-      Rigid3d cur_from_prev = *input.predicted_cam_from_world * prev.cam_from_world->inverse();
       // The constant-velocity prediction alone failed 29 % of KITTI 00's background at 2 px
       // (its rotation lags the turns), refined on the background 8 %, as the true motion.
-      std::vector<Eigen::Vector2d> background_prev, background_cur;
-      for (const cv::DMatch& m : matches) {
-        const size_t i = static_cast<size_t>(m.queryIdx);
-        if (in_any[i]) continue;
-        if (const auto match = UndistortedMatch(kps, prev, i, m.trainIdx, *input.camera)) {
-          background_prev.push_back(match->first);
-          background_cur.push_back(match->second);
-        }
-      }
-      cur_from_prev = RefineMotionOnBackground(cur_from_prev, background_prev, background_cur,
-                                               *input.camera, params.epipolar_px);
+      const Rigid3d cur_from_prev = RefineMotionOnBackground(
+          *input.predicted_cam_from_world * prev.cam_from_world->inverse(), background_prev,
+          background_cur, *input.camera, params.epipolar_px);
       fundamental = FundamentalFromMotion(cur_from_prev, *input.camera);
     } else {
-      fundamental = FitBackgroundEpipolarGeometry(kps, prev, matches, in_any, *input.camera, params,
+      fundamental = FitBackgroundEpipolarGeometry(background_prev, background_cur, params,
                                                   &result.num_motion_inliers);
     }
     result.epipolar_fitted = fundamental.has_value();
-    auto distance = [&](size_t i, int j) -> std::optional<double> {
-      const auto match = UndistortedMatch(kps, prev, i, j, *input.camera);
-      if (!match) return std::nullopt;
-      return EpipolarDistance(*fundamental, match->first, match->second);
-    };
     // The background's own share beyond the threshold (mismatches, the prediction's error): a box
     // is moving only when its share clearly exceeds it (the box vote below).
-    int num_background = 0, background_failed = 0;
-    for (const cv::DMatch& m : matches) {
-      if (!fundamental || in_any[static_cast<size_t>(m.queryIdx)]) continue;
-      if (const auto d = distance(static_cast<size_t>(m.queryIdx), m.trainIdx)) {
-        ++num_background;
-        background_failed += *d > params.epipolar_px ? 1 : 0;
-      }
+    if (fundamental && static_cast<int>(background_prev.size()) >= params.motion_min_inliers) {
+      int failed = 0;
+      for (size_t k = 0; k < background_prev.size(); ++k)
+        failed += EpipolarDistance(*fundamental, background_prev[k], background_cur[k]) >
+                          params.epipolar_px
+                      ? 1
+                      : 0;
+      background_failure =
+          static_cast<double>(failed) / static_cast<double>(background_prev.size());
     }
-    if (num_background >= params.motion_min_inliers)
-      background_failure = static_cast<double>(background_failed) / num_background;
     for (size_t i = 0; fundamental && i < n; ++i) {
       if (!active(i) || !in_large[i] || result.labels[i] != PointLabel::kKept) continue;
       const int j = prev_of[i];
       if (j < 0) continue;
-      const auto d = distance(i, j);
-      if (!d) continue;
+      const auto match = UndistortedMatch(kps, prev, i, j, *input.camera);
+      if (!match) continue;
       judged[i] = 1;
-      if (*d > params.epipolar_px) result.labels[i] = PointLabel::kDynamicStage1;
+      if (EpipolarDistance(*fundamental, match->first, match->second) > params.epipolar_px)
+        result.labels[i] = PointLabel::kDynamicStage1;
     }
   }
 

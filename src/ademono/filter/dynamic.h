@@ -66,12 +66,12 @@ struct DynamicResult {
 };
 
 // The fundamental matrix (undistorted pixels, previous to current: x_cur^T F x_prev = 0) fitted to
-// the matches whose current point is outside every box, RANSAC at params.epipolar_px. nullopt
-// with fewer than params.motion_min_inliers matches or inliers.
+// background correspondences, RANSAC at params.epipolar_px. nullopt with fewer than
+// params.motion_min_inliers correspondences or inliers.
 std::optional<Eigen::Matrix3d> FitBackgroundEpipolarGeometry(
-    const std::vector<cv::KeyPoint>& keypoints, const PreviousFrameFeatures& previous,
-    const std::vector<cv::DMatch>& matches, const std::vector<char>& in_box, const Camera& camera,
-    const DynamicParams& params, int* num_inliers = nullptr);
+    const std::vector<Eigen::Vector2d>& background_prev,
+    const std::vector<Eigen::Vector2d>& background_cur, const DynamicParams& params,
+    int* num_inliers = nullptr);
 
 // The motion from the previous to the current camera, from `cur_from_prev` (a prediction) refined
 // on background correspondences (undistorted pixels) by Gauss-Newton on their Sampson distances,
