@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include "ademono/core/memory.h"
 #include "ademono/core/timing.h"
 
 namespace ademono {
@@ -137,6 +138,7 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
     gt.world_from_cam_gt = current.frame.world_from_cam_gt;
     result.ground_truth_frames.push_back(std::move(gt));
     ++result.frames;
+    if (result.frames % kReleaseFreedMemoryEveryFrames == 0) ReleaseFreedMemory();
   };
   if (options.feed != nullptr) {
     while (!stop_requested()) {
