@@ -10,8 +10,9 @@
 
 int main(int argc, char** argv) {
   // Two arenas for a run's threads (tracking, mapping, the prefetch workers): with glibc's
-  // default of 8 per core, a 3,000-frame run's peak RSS grew 27 MB beyond its heap's growth
-  // (docs/performance.md "Memory of long runs"). MALLOC_ARENA_MAX in the environment wins.
+  // default of 8 per core, seq-a's peak RSS grew 27 MB from 1,000 to 3,000 frames, 19 MB more
+  // than its heap (docs/performance.md "Memory of long runs"). MALLOC_ARENA_MAX in the
+  // environment wins.
   ademono::LimitMallocArenas(2);
   CLI::App app{
       "ademono: monocular SLAM with metric depth, dynamic-object and distant-point filtering"};
