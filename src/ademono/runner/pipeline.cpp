@@ -8,6 +8,7 @@
 
 #include "ademono/core/memory.h"
 #include "ademono/core/timing.h"
+#include "ademono/core/worker_pool.h"
 
 namespace ademono {
 namespace {
@@ -22,12 +23,12 @@ struct Prepared {
   double decode_cpu_ms = 0;
 };
 
-// Depth, detections, ORB features and keypoint depths of a loaded frame. With `parallel`, the ORB
-// extraction (which needs only the image) runs on its own thread beside the depth network, and so
-// does the detector when there is a depth network too (the method's three parallel branches: two
-// single-threaded ONNX sessions on two cores); either way the result is the same.
+// Depth, detections, ORB features and keypoint depths of a loaded frame. With `helpers`, the ORB
+// extraction (which needs only the image) runs on a helper thread beside the depth network, and
+// so does the detector when there is a depth network too (the method's three parallel branches:
+// two single-threaded ONNX sessions on two cores); either way the result is the same.
 void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth, Detector* detector,
-                   const System& system, bool parallel) {
+                   const System& system, WorkerPool* helpers) {
   const double cpu_start = ThreadCpuMs();
   std::future<std::pair<ExtractedFrame, double>> features;
   std::future<double> detected;  // CPU ms; fills p.detections and p.detection_ms
@@ -38,14 +39,14 @@ void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth, 
     p.detection_ms = MsSince(start);
     return ThreadCpuMs() - cpu;
   };
-  if (parallel) {
-    features = std::async(std::launch::async, [&system, &p] {
+  if (helpers != nullptr) {
+    features = helpers->Submit([&system, &p] {
       const double cpu = ThreadCpuMs();
       ExtractedFrame e = system.ExtractFeatures(p.frame);
       return std::make_pair(std::move(e), ThreadCpuMs() - cpu);
     });
     if (detector != nullptr && depth != nullptr && depth->Name() != "sensor")
-      detected = std::async(std::launch::async, detect);
+      detected = helpers->Submit(detect);
   }
   double detection_cpu = 0;
   try {
@@ -64,7 +65,7 @@ void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth, 
     throw;
   }
   double extraction_cpu = 0;
-  if (parallel) {
+  if (features.valid()) {
     std::tie(p.extracted, extraction_cpu) = features.get();
   } else {
     p.extracted = system.ExtractFeatures(p.frame);
@@ -74,7 +75,7 @@ void PrepareLoaded(Prepared& p, const Sequence& sequence, DepthProvider* depth, 
 }
 
 Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detector,
-                 const System& system, bool parallel, size_t i) {
+                 const System& system, WorkerPool* helpers, size_t i) {
   Prepared p;
   const double cpu_start = ThreadCpuMs();
   const auto start = Now();
@@ -82,7 +83,7 @@ Prepared Prepare(const Sequence& sequence, DepthProvider* depth, Detector* detec
   p.frame = ReadsSequenceDepth(depth) ? sequence.Load(i) : sequence.LoadWithoutDepth(i);
   p.decode_ms = MsSince(start);
   p.cpu_ms = p.decode_cpu_ms = ThreadCpuMs() - cpu_start;
-  PrepareLoaded(p, sequence, depth, detector, system, parallel);
+  PrepareLoaded(p, sequence, depth, detector, system, helpers);
   return p;
 }
 
@@ -100,11 +101,20 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   // detector); a sensor depth map costs nothing to hide behind.
   const bool parallel_extraction =
       options.overlap && (detector != nullptr || (depth != nullptr && depth->Name() != "sensor"));
+  // Threads that live for the run (worker_pool.h says why). Each preparation in flight may hand
+  // its extraction and its detector to two helpers. The helpers are declared first so that they
+  // outlive the preparations waiting for them.
+  std::optional<WorkerPool> helpers, preparers;
+  if (options.overlap && options.feed == nullptr) {
+    if (parallel_extraction) helpers.emplace(2 * static_cast<int>(depth_ahead));
+    preparers.emplace(static_cast<int>(depth_ahead));
+  }
+  WorkerPool* helper_pool = helpers ? &*helpers : nullptr;
   result.prefetched = options.overlap && options.feed == nullptr;
   auto stop_requested = [&] {
     if (options.stop == nullptr || !options.stop->load()) return false;
     result.stopped = true;
-    return true;  // a prefetch in flight is waited for by the future's destructor
+    return true;  // a preparation in flight is finished by the pool's destructor
   };
   // `cpu_ms`: what the tracking thread already spent on this frame (decode/extraction inline).
   auto track = [&](Prepared& current, double cpu_ms, double wait_ms, bool prefetched) {
@@ -146,7 +156,7 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
       if (!frame) break;
       Prepared current;
       current.frame = std::move(*frame);
-      PrepareLoaded(current, sequence, depth, detector, system, false);
+      PrepareLoaded(current, sequence, depth, detector, system, nullptr);
       track(current, current.cpu_ms, 0, false);
     }
   } else {
@@ -167,13 +177,15 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
         }
         wait_ms = MsSince(wait_start);
       } else {
-        current = Prepare(sequence, depth, detector, system, false, i);
+        current = Prepare(sequence, depth, detector, system, nullptr, i);
         inline_cpu =
             current.cpu_ms - current.decode_cpu_ms;  // the tracking thread: decode excluded
       }
       while (options.overlap && launched < end && launched <= i + depth_ahead) {
-        ahead.push_back(std::async(std::launch::async, Prepare, std::cref(sequence), depth,
-                                   detector, std::cref(system), parallel_extraction, launched));
+        ahead.push_back(preparers->Submit([&sequence, depth, detector, &system, helper_pool,
+                                           frame = launched] {
+          return Prepare(sequence, depth, detector, system, helper_pool, frame);
+        }));
         ++launched;
       }
       track(current, inline_cpu, wait_ms, prefetched);
