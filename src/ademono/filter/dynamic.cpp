@@ -160,10 +160,8 @@ Rigid3d RefineMotionOnBackground(const Rigid3d& cur_from_prev,
   const double f = 0.5 * (camera.fx + camera.fy);
   std::vector<Eigen::Vector3d> a, b;
   for (size_t k = 0; k < prev_px.size(); ++k) {
-    a.emplace_back((prev_px[k].x() - camera.cx) / camera.fx,
-                   (prev_px[k].y() - camera.cy) / camera.fy, 1.0);
-    b.emplace_back((cur_px[k].x() - camera.cx) / camera.fx, (cur_px[k].y() - camera.cy) / camera.fy,
-                   1.0);
+    a.push_back(camera.Unproject(prev_px[k], 1.0));  // normalised coordinates
+    b.push_back(camera.Unproject(cur_px[k], 1.0));
   }
   Eigen::Matrix3d rotation = cur_from_prev.rotation();
   Eigen::Vector3d direction = cur_from_prev.translation();
