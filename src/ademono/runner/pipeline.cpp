@@ -101,16 +101,16 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   // detector); a sensor depth map costs nothing to hide behind.
   const bool parallel_extraction =
       options.overlap && (detector != nullptr || (depth != nullptr && depth->Name() != "sensor"));
+  result.prefetched = options.overlap && options.feed == nullptr;
   // Threads that live for the run (worker_pool.h says why). Each preparation in flight may hand
   // its extraction and its detector to two helpers. The helpers are declared first so that they
   // outlive the preparations waiting for them.
   std::optional<WorkerPool> helpers, preparers;
-  if (options.overlap && options.feed == nullptr) {
+  if (result.prefetched) {
     if (parallel_extraction) helpers.emplace(2 * static_cast<int>(depth_ahead));
     preparers.emplace(static_cast<int>(depth_ahead));
   }
   WorkerPool* helper_pool = helpers ? &*helpers : nullptr;
-  result.prefetched = options.overlap && options.feed == nullptr;
   auto stop_requested = [&] {
     if (options.stop == nullptr || !options.stop->load()) return false;
     result.stopped = true;
