@@ -243,6 +243,7 @@ def main():
                                         "--set", "depth.camera_height=0"]),
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
+                (r, "unsmoothed_frames", ["--set", "tracking.smooth_trajectory=false"]),
             ]
             # The keyframe scale prior, off in both families, on.
             ablation.append((r, "scale_prior", ["--set", "mapping.network_scale_prior=true"]))

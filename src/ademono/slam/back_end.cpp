@@ -8,6 +8,7 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/timing.h"
+#include "ademono/optimize/trajectory_smoothing.h"
 #include "ademono/slam/map_io.h"
 
 namespace ademono {
@@ -208,6 +209,16 @@ Trajectory BackEnd::FrameTrajectory() const {
     if (!r.tracked || r.reference == nullptr) continue;
     const Rigid3d cam_from_world = ResolveFramePose(r);
     trajectory.push_back({r.timestamp, cam_from_world.inverse()});
+  }
+  if (options_.tracking.smooth_trajectory) {
+    std::vector<double> times;
+    std::vector<Rigid3d> poses;
+    for (const StampedPose& p : trajectory) {
+      times.push_back(p.timestamp);
+      poses.push_back(p.world_from_cam);
+    }
+    poses = SmoothPoses(times, poses);
+    for (size_t i = 0; i < trajectory.size(); ++i) trajectory[i].world_from_cam = poses[i];
   }
   return trajectory;
 }

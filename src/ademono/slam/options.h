@@ -161,6 +161,11 @@ struct TrackingOptions {
   // blended by time (ResolveFramePose), instead of their reference keyframe's alone. On in
   // network_indoor.yaml, whose young triangulated points move most after a frame is tracked.
   bool interpolate_trajectory = false;
+  // The trajectory's frames re-estimated after the run under a motion model (a smoothing spline
+  // per coordinate, its strength chosen from the run's own poses by cross-validation:
+  // optimize/trajectory_smoothing.h). A frame's pose from one image scatters by millimetres
+  // where a sideways step and a turn look alike. On in the monocular families.
+  bool smooth_trajectory = false;
   // Localisation only (--load-map --localize-only), where the camera leaves the loaded map:
   // true keeps a temporary local map in memory (keyframes and points made there, local BA with
   // the loaded keyframes and points held fixed; never saved, no loop closed), as ORB-SLAM3's
