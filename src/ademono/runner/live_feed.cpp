@@ -20,7 +20,8 @@ std::optional<Eigen::Vector3d> PositionAt(const Trajectory& trajectory,
 
 }  // namespace
 
-LiveMap LiveFeed::Snapshot(const System& system, size_t frame, double timestamp) const {
+LiveMap LiveFeed::Snapshot(const System& system, size_t frame, double timestamp,
+                           FramePoses poses) const {
   LiveMap map;
   map.frame = frame;
   map.timestamp = timestamp;
@@ -28,7 +29,7 @@ LiveMap LiveFeed::Snapshot(const System& system, size_t frame, double timestamp)
   map.points.reserve(cloud.size());
   for (const ColoredPoint& p : cloud)
     map.points.push_back({p.position.cast<float>(), static_cast<float>(p.static_probability)});
-  map.trajectory = system.FrameTrajectory();
+  map.trajectory = system.FrameTrajectory(poses);
   map.keyframes = system.KeyFrameTrajectory();
   for (const LoopEvent& loop : system.Loops()) {
     const auto a = PositionAt(map.trajectory, timestamps_, loop.query_frame);
@@ -77,7 +78,9 @@ void LiveFeed::Frame(const System& system, const FrameData& frame,
   loops_seen_ = loops.size();
   if (observer_->WantsMapSnapshot(map_stale_)) {
     map_stale_ = false;
-    observer_->OnMap(Snapshot(system, frame.index, frame.timestamp));
+    // The path as resolved: smoothing the whole run at every snapshot would cost the tracking
+    // thread ~4 ms per 1,000 frames (bench_trajectory_smoothing); the final snapshot has it.
+    observer_->OnMap(Snapshot(system, frame.index, frame.timestamp, FramePoses::kResolved));
   }
 }
 
@@ -85,7 +88,7 @@ void LiveFeed::End(const System& system, const LiveEnd& end) {
   if (observer_ == nullptr) return;
   const double timestamp = timestamps_.empty() ? 0.0 : timestamps_.rbegin()->second;
   const size_t frame = timestamps_.empty() ? 0 : timestamps_.rbegin()->first;
-  LiveMap map = Snapshot(system, frame, timestamp);
+  LiveMap map = Snapshot(system, frame, timestamp, FramePoses::kWritten);
   map.final = true;
   observer_->OnEnd(std::move(map), end);
 }

@@ -90,7 +90,7 @@ class LiveFeed {
   void End(const System& system, const LiveEnd& end);
 
  private:
-  LiveMap Snapshot(const System& system, size_t frame, double timestamp) const;
+  LiveMap Snapshot(const System& system, size_t frame, double timestamp, FramePoses poses) const;
   RunObserver* observer_;
   size_t loops_seen_ = 0;
   bool map_stale_ = false;  // changed since the last snapshot

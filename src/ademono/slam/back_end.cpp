@@ -202,23 +202,26 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   return result;
 }
 
-Trajectory BackEnd::FrameTrajectory() const {
-  MutexLock lock(map_.mutex);
+Trajectory BackEnd::FrameTrajectory(FramePoses poses) const {
   Trajectory trajectory;
-  for (const FrameRecord& r : tracking_.Records()) {
-    if (!r.tracked || r.reference == nullptr) continue;
-    const Rigid3d cam_from_world = ResolveFramePose(r);
-    trajectory.push_back({r.timestamp, cam_from_world.inverse()});
+  {
+    MutexLock lock(map_.mutex);
+    for (const FrameRecord& r : tracking_.Records()) {
+      if (!r.tracked || r.reference == nullptr) continue;
+      const Rigid3d cam_from_world = ResolveFramePose(r);
+      trajectory.push_back({r.timestamp, cam_from_world.inverse()});
+    }
   }
-  if (options_.tracking.smooth_trajectory) {
+  // Outside the map's lock: local mapping need not wait for it.
+  if (poses == FramePoses::kWritten && options_.tracking.smooth_trajectory) {
     std::vector<double> times;
-    std::vector<Rigid3d> poses;
+    std::vector<Rigid3d> world_from_cam;
     for (const StampedPose& p : trajectory) {
       times.push_back(p.timestamp);
-      poses.push_back(p.world_from_cam);
+      world_from_cam.push_back(p.world_from_cam);
     }
-    poses = SmoothPoses(times, poses);
-    for (size_t i = 0; i < trajectory.size(); ++i) trajectory[i].world_from_cam = poses[i];
+    world_from_cam = SmoothPoses(times, world_from_cam);
+    for (size_t i = 0; i < trajectory.size(); ++i) trajectory[i].world_from_cam = world_from_cam[i];
   }
   return trajectory;
 }

@@ -24,6 +24,9 @@
 
 namespace ademono {
 
+// Which frame poses a trajectory holds (BackEnd::FrameTrajectory).
+enum class FramePoses { kWritten, kResolved };
+
 struct ColoredPoint {
   Eigen::Vector3d position;
   cv::Vec3b bgr;
@@ -72,7 +75,9 @@ class BackEnd {
   // Loops closed so far (loop closing, docs/loops.md).
   std::vector<LoopEvent> Loops() const;
 
-  Trajectory FrameTrajectory() const;
+  // kWritten: as the run writes it (smoothed where tracking.smooth_trajectory says so);
+  // kResolved: against the keyframes only (cheaper, for the live view's periodic snapshots).
+  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten) const;
   Trajectory KeyFrameTrajectory() const;
   std::vector<std::pair<size_t, double>> DepthScales() const;
   // Monocular core with a network: each live keyframe's fitted network error model (input

@@ -88,7 +88,9 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   return result;
 }
 
-Trajectory System::FrameTrajectory() const { return back_end_.FrameTrajectory(); }
+Trajectory System::FrameTrajectory(FramePoses poses) const {
+  return back_end_.FrameTrajectory(poses);
+}
 Trajectory System::KeyFrameTrajectory() const { return back_end_.KeyFrameTrajectory(); }
 std::vector<std::pair<size_t, double>> System::DepthScales() const {
   return back_end_.DepthScales();

@@ -88,8 +88,9 @@ class System {
   }
   void SaveMap(const std::filesystem::path& path) { back_end_.SaveMap(path); }
 
-  // Pose of every tracked input frame, resolved against the current keyframe poses.
-  Trajectory FrameTrajectory() const;
+  // Pose of every tracked input frame, resolved against the current keyframe poses (and, as
+  // written, smoothed where tracking.smooth_trajectory is on).
+  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten) const;
   Trajectory KeyFrameTrajectory() const;
   // Network depth: the scale correction of every tracked frame (input index, factor), against
   // the final map (anchoring rescales update it); 1 for sensor depth.
