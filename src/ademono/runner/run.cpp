@@ -200,7 +200,12 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   report.lost = system.NumLost();
   report.keyframes = system.NumKeyFrames();
   report.map_points = system.NumMapPoints();
-  report.trajectory = system.FrameTrajectory();
+  if (options.system.tracking.smooth_trajectory) {
+    report.smoothing.emplace();
+    report.trajectory = system.FrameTrajectory(FramePoses::kWritten, &*report.smoothing);
+  } else {
+    report.trajectory = system.FrameTrajectory();
+  }
   report.keyframe_trajectory = system.KeyFrameTrajectory();
   report.ground_heights = system.GroundHeights();
   report.ground_height_frames = system.GroundHeightFrames();
@@ -304,6 +309,13 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     j["depth_scale"] = {{"median", Percentile(depth_scales, 0.5)},
                         {"p10", Percentile(depth_scales, 0.1)},
                         {"p90", Percentile(depth_scales, 0.9)}};
+  }
+  if (report.smoothing) {
+    // The written frames against the frames as tracked and resolved (docs/slam.md "Frames
+    // smoothed").
+    j["trajectory_smoothing"] = {{"segments", report.smoothing->segments},
+                                 {"rms_shift_m", report.smoothing->rms_shift_m},
+                                 {"max_shift_m", report.smoothing->max_shift_m}};
   }
   if (o.depth.GroundScale()) {
     // The map's scale from the known camera height: how often the ground was found and the

@@ -126,6 +126,8 @@ struct RunReport {
   std::string accuracy_note;  // why `accuracy` is missing, if it is
   std::optional<TruthCounts> truth;
   Trajectory trajectory;           // every tracked frame
+  // How far tracking.smooth_trajectory moved the frames (unset when it is off).
+  std::optional<PoseSmoothingReport> smoothing;
   Trajectory keyframe_trajectory;  // keyframes at the end of the run
   // The dataset's ground-truth poses associated with `trajectory` (eval's association; empty
   // without ground truth).

@@ -8,7 +8,6 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/timing.h"
-#include "ademono/optimize/trajectory_smoothing.h"
 #include "ademono/slam/map_io.h"
 
 namespace ademono {
@@ -202,7 +201,7 @@ BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
   return result;
 }
 
-Trajectory BackEnd::FrameTrajectory(FramePoses poses) const {
+Trajectory BackEnd::FrameTrajectory(FramePoses poses, PoseSmoothingReport* smoothing) const {
   Trajectory trajectory;
   {
     MutexLock lock(map_.mutex);
@@ -220,7 +219,7 @@ Trajectory BackEnd::FrameTrajectory(FramePoses poses) const {
       times.push_back(p.timestamp);
       world_from_cam.push_back(p.world_from_cam);
     }
-    world_from_cam = SmoothPoses(times, world_from_cam);
+    world_from_cam = SmoothPoses(times, world_from_cam, smoothing);
     for (size_t i = 0; i < trajectory.size(); ++i) trajectory[i].world_from_cam = world_from_cam[i];
   }
   return trajectory;

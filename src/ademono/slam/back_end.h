@@ -12,6 +12,7 @@
 #include "ademono/core/camera.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
+#include "ademono/optimize/trajectory_smoothing.h"
 #include "ademono/perception/detection.h"
 #include "ademono/place/keyframe_database.h"
 #include "ademono/slam/front_end.h"
@@ -77,7 +78,8 @@ class BackEnd {
 
   // kWritten: as the run writes it (smoothed where tracking.smooth_trajectory says so);
   // kResolved: against the keyframes only (cheaper, for the live view's periodic snapshots).
-  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten) const;
+  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten,
+                             PoseSmoothingReport* smoothing = nullptr) const;
   Trajectory KeyFrameTrajectory() const;
   std::vector<std::pair<size_t, double>> DepthScales() const;
   // Monocular core with a network: each live keyframe's fitted network error model (input

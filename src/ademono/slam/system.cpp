@@ -88,8 +88,8 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
   return result;
 }
 
-Trajectory System::FrameTrajectory(FramePoses poses) const {
-  return back_end_.FrameTrajectory(poses);
+Trajectory System::FrameTrajectory(FramePoses poses, PoseSmoothingReport* smoothing) const {
+  return back_end_.FrameTrajectory(poses, smoothing);
 }
 Trajectory System::KeyFrameTrajectory() const { return back_end_.KeyFrameTrajectory(); }
 std::vector<std::pair<size_t, double>> System::DepthScales() const {

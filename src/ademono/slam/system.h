@@ -90,7 +90,8 @@ class System {
 
   // Pose of every tracked input frame, resolved against the current keyframe poses (and, as
   // written, smoothed where tracking.smooth_trajectory is on).
-  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten) const;
+  Trajectory FrameTrajectory(FramePoses poses = FramePoses::kWritten,
+                             PoseSmoothingReport* smoothing = nullptr) const;
   Trajectory KeyFrameTrajectory() const;
   // Network depth: the scale correction of every tracked frame (input index, factor), against
   // the final map (anchoring rescales update it); 1 for sensor depth.
