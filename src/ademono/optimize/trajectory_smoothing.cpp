@@ -61,7 +61,7 @@ double InverseTrace(const BandedLdl& f) {
     const double a = i + 1 < n ? f.l1[i + 1] : 0.0;  // L(i+1, i)
     const double b = i + 2 < n ? f.l2[i + 2] : 0.0;  // L(i+2, i)
     if (i + 2 < n) z2[i] = -(a * z1[i + 1] + b * z0[i + 2]);
-    if (i + 1 < n) z1[i] = -(a * z0[i + 1] + b * (i + 2 < n ? z1[i + 1] : 0.0));
+    if (i + 1 < n) z1[i] = -(a * z0[i + 1] + b * z1[i + 1]);  // b = 0 when i + 2 == n
     z0[i] = 1.0 / f.d[i] - a * z1[i] - b * z2[i];
     trace += z0[i];
   }

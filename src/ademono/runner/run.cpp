@@ -200,12 +200,9 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   report.lost = system.NumLost();
   report.keyframes = system.NumKeyFrames();
   report.map_points = system.NumMapPoints();
-  if (options.system.tracking.smooth_trajectory) {
-    report.smoothing.emplace();
-    report.trajectory = system.FrameTrajectory(FramePoses::kWritten, &*report.smoothing);
-  } else {
-    report.trajectory = system.FrameTrajectory();
-  }
+  PoseSmoothingReport smoothing;
+  report.trajectory = system.FrameTrajectory(FramePoses::kWritten, &smoothing);
+  if (options.system.tracking.smooth_trajectory) report.smoothing = smoothing;
   report.keyframe_trajectory = system.KeyFrameTrajectory();
   report.ground_heights = system.GroundHeights();
   report.ground_height_frames = system.GroundHeightFrames();
