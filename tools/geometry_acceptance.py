@@ -18,7 +18,9 @@ geometric mode must be within 1.5x of it. --cache replays `ademono infer`
 caches (made once under OUT/cache) instead of running the networks: faster, the same settings
 family and error model, depths rounded to the cache's millimetres. --ablation adds the variants of
 the new design on seq-a and KITTI (docs/slam.md "Ablation").
-Prints one Markdown table; writes OUT/acceptance.json.
+Prints one Markdown table; writes OUT/acceptance.json. "map scale" is summary.json's map_scale:
+the median over keyframes of the dataset's depth against the final map's (the factor that makes
+the map metric, read where the map is, whatever the trajectory's shape; "-" without depth images).
 """
 import argparse
 import concurrent.futures
@@ -284,7 +286,8 @@ def main():
             row = dict(sequence=r, depth=m, frames=s["frames"], tracked=s["tracked"],
                        first_tracked=start, tracked_from_init=s["tracked"] / max(1, from_init),
                        keyframes=s["keyframes"], sim3=acc.get("ate_sim3_rmse_m"),
-                       se3=acc.get("ate_se3_rmse_m"), scale=acc.get("sim3_scale"), fps=s["fps"])
+                       se3=acc.get("ate_se3_rmse_m"), scale=acc.get("sim3_scale"),
+                       map_scale=s.get("map_scale", {}).get("median"), fps=s["fps"])
             if m != "none":
                 row["sim3_on_none_frames"] = sim3_on(a.bin, folders[(r, m)], folders[(r, "none")],
                                                      folders[(r, m)])
@@ -327,18 +330,20 @@ def main():
         table.append(dict(sequence=r, depth=variant, frames=s["frames"], tracked=s["tracked"],
                           keyframes=s["keyframes"], sim3=acc.get("ate_sim3_rmse_m"),
                           se3=acc.get("ate_se3_rmse_m"), scale=acc.get("sim3_scale"),
+                          map_scale=s.get("map_scale", {}).get("median"),
                           fps=s["fps"], ablation=True))
 
     def f(v, fmt="%.4f"):
         return "-" if v is None else fmt % v
     print("| sequence | depth | tracked | first tracked | keyframes | ATE sim3 (m) | ATE se3 (m) "
-          "| sim3 scale | sim3 on none's frames | / none | frames/s | criteria met |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| sim3 scale | map scale | sim3 on none's frames | / none | frames/s | criteria met |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for t in table:
         met = "-" if "met" not in t else ("yes" if t["met"] else "NO: " + ", ".join(t["failed"]))
-        print("| %s | %s | %d/%d | %s | %d | %s | %s | %s | %s | %s | %.1f | %s |" % (
+        print("| %s | %s | %d/%d | %s | %d | %s | %s | %s | %s | %s | %s | %.1f | %s |" % (
             t["sequence"], t["depth"], t["tracked"], t["frames"], t.get("first_tracked", "-"),
             t["keyframes"], f(t["sim3"]), f(t["se3"]), f(t["scale"], "%.3f"),
+            f(t.get("map_scale"), "%.3f"),
             f(t.get("sim3_on_none_frames")), f(t.get("vs_none"), "%.2f"), t["fps"], met))
     for t in table:
         if "vs_sensor" in t:

@@ -98,8 +98,24 @@ TEST_F(GeometricCliTest, GeometryAloneIsWithinOneAndAHalfTimesSensorDepthOnTheOf
   EXPECT_EQ(smoothing["segments"].get<int>(), 1) << "292 frames, none lost after the start";
   EXPECT_GT(smoothing["rms_shift_m"].get<double>(), 0.0005);
   EXPECT_LT(smoothing["max_shift_m"].get<double>(), 0.02);
-  EXPECT_FALSE(nlohmann::json::parse(ReadFile(sensor / "summary.json"))
-                   .contains("trajectory_smoothing"));
+  const nlohmann::json sensor_summary = nlohmann::json::parse(ReadFile(sensor / "summary.json"));
+  EXPECT_FALSE(sensor_summary.contains("trajectory_smoothing"));
+
+  // The map's scale against the dataset's depth images, keyframe by keyframe: the geometric
+  // map's arbitrary scale, which the sim3 alignment reads from the trajectory too (the office
+  // moves 0.6 m, so both read the same); the sensor's map metric.
+  ASSERT_TRUE(none_summary.contains("map_scale"));
+  const nlohmann::json& map_scale = none_summary["map_scale"];
+  const double sim3_scale = none_summary["accuracy"]["sim3_scale"].get<double>();
+  EXPECT_EQ(map_scale["keyframes"].get<size_t>(), map_scale["per_keyframe"].size());
+  EXPECT_GE(map_scale["keyframes"].get<int>(), 15) << "measured: 18 of 18";
+  EXPECT_NEAR(map_scale["median"].get<double>() / sim3_scale, 1.0, 0.05)
+      << "measured: 3.335 against 3.279";
+  EXPECT_LT(map_scale["p90"].get<double>() / map_scale["p10"].get<double>(), 1.02)
+      << "one scale over the whole map (measured 1.003)";
+  ASSERT_TRUE(sensor_summary.contains("map_scale"));
+  EXPECT_NEAR(sensor_summary["map_scale"]["median"].get<double>(), 1.0, 0.01)
+      << "measured: 1.000";
 }
 
 }  // namespace

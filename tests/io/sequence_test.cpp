@@ -100,6 +100,10 @@ TEST(SevenScenesTest, ReadsFramesDepthPosesAndIntrinsics) {
   EXPECT_EQ(cv::norm(g.image, f.image, cv::NORM_INF), 0.0);
   ASSERT_TRUE(g.world_from_cam_gt.has_value());
   EXPECT_EQ(g.world_from_cam_gt->translation().x(), 2.0);
+  // Only the depth image (evaluations read it after a run): the same metres as Load's.
+  const cv::Mat d = seq->LoadDepth(2);
+  ASSERT_EQ(d.type(), CV_32FC1);
+  EXPECT_EQ(cv::norm(d, f.depth, cv::NORM_INF), 0.0);
 }
 
 TEST(SevenScenesTest, ReportsBadInput) {
@@ -126,6 +130,8 @@ TEST(SevenScenesTest, ReportsBadInput) {
   EXPECT_THAT(ExpectInputError([&] { seq->Load(0); }),
               HasSubstr("frame-000000.depth.png: image does not decode"));
   EXPECT_TRUE(seq->LoadWithoutDepth(0).depth.empty());
+  EXPECT_THAT(ExpectInputError([&] { seq->LoadDepth(0); }),
+              HasSubstr("frame-000000.depth.png: image does not decode"));
 
   EXPECT_THAT(ExpectInputError([] { OpenSequence("nope:/tmp"); }),
               HasSubstr("unknown kind 'nope'"));

@@ -43,6 +43,17 @@ FrameData FileSequence::LoadFrame(size_t i, bool with_depth) const {
   return frame;
 }
 
+cv::Mat FileSequence::LoadDepth(size_t i) const {
+  const FileFrame& f = spec_.frames.at(i);
+  if (f.depth.empty()) return {};
+  cv::Mat depth =
+      DepthToMetres(ReadImage(f.depth, cv::IMREAD_UNCHANGED), spec_.depth_scale, f.depth);
+  if (depth.size() != cv::Size(spec_.camera.width, spec_.camera.height)) {
+    ThrowInputError(f.depth, "depth image size differs from the colour image size");
+  }
+  return depth;
+}
+
 cv::Mat ToBgr8(const cv::Mat& image, const fs::path& path) {
   cv::Mat eight_bit = image;
   if (image.depth() == CV_16U) {

@@ -45,6 +45,7 @@ class FileSequence : public Sequence {
   bool HasGroundTruth() const override { return spec_.has_ground_truth; }
   FrameData Load(size_t i) const override { return LoadFrame(i, true); }
   FrameData LoadWithoutDepth(size_t i) const override { return LoadFrame(i, false); }
+  cv::Mat LoadDepth(size_t i) const override;
   double Timestamp(size_t i) const override;
   std::optional<double> CameraHeight() const override { return spec_.camera_height; }
 

@@ -39,6 +39,9 @@ class Sequence {
   // depth comes from elsewhere (a network, --depth none): 7-Scenes' 16-bit PNG costs about as
   // much to decode as its colour JPEG. Sequences without depth files load as Load does.
   virtual FrameData LoadWithoutDepth(size_t i) const { return Load(i); }
+  // Only frame i's depth image (empty when the dataset has none), for evaluations that read the
+  // sensor after the run (eval/map_scale.h). Same errors as Load.
+  virtual cv::Mat LoadDepth(size_t i) const { return Load(i).depth; }
   // Timestamp of frame i without decoding images.
   virtual double Timestamp(size_t i) const = 0;
   // The camera's height above the road in metres when the dataset knows its rig (KITTI: 1.65 m),

@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "ademono/core/statistics.h"
 #include "ademono/eval/trajectory_eval.h"
@@ -118,6 +119,34 @@ Trajectory AssociatedGroundTruth(const Trajectory& ground_truth, const Trajector
   return associated;
 }
 
+// The final map against the dataset's depth images: each keyframe's observed points at their
+// depth in it, against the sensor's reading under the keypoint (eval/map_scale.h).
+std::optional<MapScaleReport> MeasureMapScale(const Sequence& sequence, const MapFileData& map) {
+  std::unordered_map<uint64_t, const MapKeyFrameRecord*> keyframes;
+  for (const MapKeyFrameRecord& k : map.keyframes) keyframes[k.id] = &k;
+  std::map<uint64_t, std::vector<MapDepthObservation>> observations;  // by keyframe id
+  for (const MapPointRecord& p : map.points) {
+    const Eigen::Vector3d world(p.position[0], p.position[1], p.position[2]);
+    for (const auto& [keyframe_id, keypoint] : p.observations) {
+      const auto it = keyframes.find(keyframe_id);
+      if (it == keyframes.end() || keypoint >= it->second->keypoints.size()) continue;
+      const MapKeyFrameRecord& k = *it->second;
+      const std::array<double, 12>& m = k.cam_from_world;  // 3x4 row-major
+      const double depth = m[8] * world.x() + m[9] * world.y() + m[10] * world.z() + m[11];
+      observations[keyframe_id].push_back(
+          {Eigen::Vector2d(k.keypoints[keypoint].x, k.keypoints[keypoint].y), depth});
+    }
+  }
+  std::vector<KeyFrameMapScale> measured;
+  for (const auto& [keyframe_id, list] : observations) {
+    const size_t frame = keyframes.at(keyframe_id)->index;
+    if (frame >= sequence.Size()) continue;
+    if (auto scale = MeasureKeyFrameScale(frame, list, sequence.LoadDepth(frame)))
+      measured.push_back(*scale);
+  }
+  return SummarizeMapScale(std::move(measured));
+}
+
 StageTiming Timing(const std::vector<FrameReport>& frames, double FrameTiming::*stage,
                    std::string thread) {
   std::vector<double> values;
@@ -215,6 +244,9 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     }
   }
   report.map_cloud = system.MapPointCloud();
+  // A loaded map's keyframes index another run's frames.
+  if (sequence.HasDepth() && options.load_map.empty())
+    report.map_scale = MeasureMapScale(sequence, system.MapRecords());
   report.loops = system.Loops();
   live.End(system, {report.frames, report.Tracked(), report.keyframes, report.map_points,
                     report.lost, report.partial});
@@ -306,6 +338,11 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
     j["depth_scale"] = {{"median", Percentile(depth_scales, 0.5)},
                         {"p10", Percentile(depth_scales, 0.1)},
                         {"p90", Percentile(depth_scales, 0.9)}};
+  }
+  if (report.map_scale) {
+    // The map's metric scale read where the map is: the factor from its depths to the dataset's
+    // depth images, per keyframe (1 = metric; compare accuracy.sim3_scale).
+    j["map_scale"] = report.map_scale->ToJson();
   }
   if (report.smoothing) {
     // The written frames against the frames as tracked and resolved (docs/slam.md "Frames

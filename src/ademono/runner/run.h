@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "ademono/eval/map_scale.h"
 #include "ademono/filter/feature_filter.h"
 #include "ademono/io/sequence.h"
 #include "ademono/io/trajectory.h"
@@ -129,6 +130,9 @@ struct RunReport {
   // How far tracking.smooth_trajectory moved the frames (unset when it is off).
   std::optional<PoseSmoothingReport> smoothing;
   Trajectory keyframe_trajectory;  // keyframes at the end of the run
+  // The final map's depths against the dataset's depth images per keyframe (eval/map_scale.h);
+  // unset when the dataset has none, no keyframe could be measured, or the run loaded a map.
+  std::optional<MapScaleReport> map_scale;
   // The dataset's ground-truth poses associated with `trajectory` (eval's association; empty
   // without ground truth).
   Trajectory ground_truth;
