@@ -138,7 +138,16 @@ TEST_F(RunnerTest, WriterWritesTheRunFolderWithTheSummarySchema) {
                                    "frames",    "partial",   "tracked",       "untracked",
                                    "lost",      "keyframes", "map_points",    "wall_seconds",
                                    "fps",       "timing",    "filter_counts", "accuracy",
-                                   "per_frame", "loops",     "weak_poses",    "geometric_test"}));
+                                   "per_frame", "loops",     "weak_poses",    "geometric_test",
+                                   "map_scale"}));
+  // The dataset has depth images: the map's scale against them, per keyframe (sensor depth:
+  // metric).
+  EXPECT_EQ(Keys(s["map_scale"]),
+            (std::set<std::string>{"keyframes", "median", "p10", "p90", "per_keyframe"}));
+  ASSERT_TRUE(r.map_scale.has_value());
+  EXPECT_EQ(s["map_scale"]["per_keyframe"].size(), r.map_scale->per_keyframe.size());
+  EXPECT_GE(r.map_scale->per_keyframe.size(), r.keyframes / 2);
+  EXPECT_NEAR(r.map_scale->median, 1.0, 0.01);
   // A short xyz sequence revisits no place away from the live map: no loop.
   EXPECT_TRUE(s["loops"].is_array());
   EXPECT_TRUE(s["loops"].empty());
