@@ -1,13 +1,16 @@
 // `ademono eval`: scores estimated trajectories against one ground truth the way evo (APE/RPE,
 // evo_res for several estimates) and kitti-odom-eval (t_rel/r_rel) do. See docs/evaluation.md.
 #include <algorithm>
+#include <cstdio>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
+#include "ademono/eval/shared_error.h"
 #include "ademono/eval/svg_plot.h"
 #include "ademono/eval/trajectory_eval.h"
 #include "command.h"
@@ -22,7 +25,7 @@ struct EvalArgs {
                   kitti_align;
   std::vector<std::string> est;
   double max_diff = 0.01, rpe_delta = 1;
-  bool rpe_pairs_from_reference = false, kitti_metrics = false;
+  bool rpe_pairs_from_reference = false, kitti_metrics = false, shared = false;
   std::string json, plot;
 };
 
@@ -95,6 +98,8 @@ int RunEval(const EvalArgs& a) {
   options.kitti_alignment = a.kitti_align.empty() ? KittiAlignmentFor(options.alignment)
                                                   : ParseKittiAlignment(a.kitti_align);
   options.Check();
+  if (a.shared && a.est.size() != 2)
+    throw InputError("--shared compares exactly two --est, got " + std::to_string(a.est.size()));
 
   const LoadedFile gt = Load(a.gt, a.gt_format.empty() ? a.format : a.gt_format);
   std::vector<LoadedFile> ests;
@@ -102,6 +107,15 @@ int RunEval(const EvalArgs& a) {
   for (const std::string& path : a.est) {
     ests.push_back(Load(path, a.est_format.empty() ? a.format : a.est_format));
     results.push_back(Evaluate(gt, ests.back(), options));
+  }
+
+  std::optional<SharedError> shared;
+  if (a.shared) {
+    try {
+      shared = ComputeSharedError(results[0], results[1]);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(a.est[0] + " and " + a.est[1] + ": " + e.what());
+    }
   }
 
   // Render everything before writing anything, so a failure leaves no partial output.
@@ -124,6 +138,7 @@ int RunEval(const EvalArgs& a) {
         e["est_file"] = describe(ests[k]);
         j["estimates"].push_back(e);
       }
+      if (shared) j["shared"] = shared->ToJson();
     }
     json = j.dump(2) + "\n";
   }
@@ -139,6 +154,15 @@ int RunEval(const EvalArgs& a) {
     std::cout << FormatReport(results.front());
   } else {
     std::cout << FormatTable(ests, results);
+  }
+  if (shared) {
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "shared by both: %.6f m rms; half their difference: %.6f m; correlation %.2f "
+                  "(%zu ground-truth poses both matched)\n",
+                  shared->shared_rmse, shared->half_difference_rmse, shared->correlation,
+                  shared->frames);
+    std::cout << line;
   }
   if (!a.json.empty()) WriteTextFileAtomic(a.json, json);
   if (!a.plot.empty()) WriteTextFileAtomic(a.plot, svg);
@@ -183,6 +207,9 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--kitti-align", args->kitti_align,
                      "kitti-odom-eval alignment (default: matches --align)")
           ->check(CLI::IsMember({"none", "scale", "6dof", "7dof"}));
+      app.add_flag("--shared", args->shared,
+                   "With two --est: the part of their errors they share (each aligned on its "
+                   "own), e.g. what the ground truth itself gets wrong");
       app.add_option("--json", args->json, "Write the metrics as JSON to this file");
       app.add_option("--plot", args->plot, "Write an SVG plot (top view and APE over time)");
       return [args] { return RunEval(*args); };

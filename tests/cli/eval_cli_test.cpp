@@ -139,6 +139,34 @@ TEST_F(EvalCliTest, MixedFormatsEurocGroundTruthAgainstTumEstimate) {
   EXPECT_THAT(r.out, HasSubstr("no pose pairs this far apart"));
 }
 
+TEST_F(EvalCliTest, SharedSplitsTwoEstimatesErrorsIntoWhatTheyShare) {
+  // The same estimate twice shares all of its error; the ground truth against itself has none.
+  const std::string gt = (kTraj / "evo/freiburg1_xyz-groundtruth.txt").string();
+  const std::string est = (kTraj / "evo/freiburg1_xyz-rgbdslam.txt").string();
+  const fs::path json = dir_ / "shared.json";
+  RunResult r = Run("--gt " + gt + " --est " + est + " --est " + est +
+                    " --align sim3 --shared --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("half their difference: 0.000000 m; correlation 1.00"));
+  const nlohmann::json shared = nlohmann::json::parse(ReadFile(json))["shared"];
+  EXPECT_EQ(shared["frames"].get<int>(), 785);
+  EXPECT_NEAR(shared["shared_rmse"].get<double>(), shared["rmse_a"].get<double>(), 1e-12);
+  EXPECT_GT(shared["rmse_a"].get<double>(), 0.005);
+  r = Run("--gt " + gt + " --est " + est + " --est " + gt + " --align sim3 --shared --json " +
+          json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json half = nlohmann::json::parse(ReadFile(json))["shared"];
+  EXPECT_NEAR(half["shared_rmse"].get<double>(), 0.5 * half["rmse_a"].get<double>(), 1e-9);
+  EXPECT_NEAR(half["rmse_b"].get<double>(), 0.0, 1e-6);
+
+  // --shared needs exactly two estimates: one line, exit 2, nothing written.
+  const fs::path none = dir_ / "none.json";
+  r = Run("--gt " + gt + " --est " + est + " --shared --json " + none.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "ademono eval: error: --shared compares exactly two --est, got 1\n");
+  EXPECT_FALSE(fs::exists(none));
+}
+
 TEST_F(EvalCliTest, NoMatchingTimestampsNamesBothFiles) {
   const fs::path json = dir_ / "none.json";
   const std::string gt = (kTraj / "evo/freiburg1_xyz-groundtruth.txt").string();

@@ -19,8 +19,7 @@ std::vector<MapDepthObservation> Observations(const cv::Mat& depth, double map_f
   std::vector<MapDepthObservation> out;
   for (int v = 2; v < depth.rows; v += 4)
     for (int u = 1; u < depth.cols; u += 3)
-      out.push_back({Eigen::Vector2d(u + 0.3, v - 0.4),
-                     map_from_metric * depth.at<float>(v, u)});
+      out.push_back({Eigen::Vector2d(u + 0.3, v - 0.4), map_from_metric * depth.at<float>(v, u)});
   return out;
 }
 

@@ -8,8 +8,8 @@
 namespace ademono {
 
 std::optional<KeyFrameMapScale> MeasureKeyFrameScale(
-    size_t frame, const std::vector<MapDepthObservation>& observations,
-    const cv::Mat& sensor_depth, size_t min_samples) {
+    size_t frame, const std::vector<MapDepthObservation>& observations, const cv::Mat& sensor_depth,
+    size_t min_samples) {
   if (sensor_depth.empty() || sensor_depth.type() != CV_32FC1) return std::nullopt;
   std::vector<double> ratios;
   ratios.reserve(observations.size());

@@ -9,10 +9,9 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace ademono {
 
@@ -34,8 +33,8 @@ struct KeyFrameMapScale {
 // pixel has a reading (nearest pixel: a depth image's edges must not be blended); nullopt with
 // fewer than `min_samples` of them.
 std::optional<KeyFrameMapScale> MeasureKeyFrameScale(
-    size_t frame, const std::vector<MapDepthObservation>& observations,
-    const cv::Mat& sensor_depth, size_t min_samples = 20);
+    size_t frame, const std::vector<MapDepthObservation>& observations, const cv::Mat& sensor_depth,
+    size_t min_samples = 20);
 
 struct MapScaleReport {
   std::vector<KeyFrameMapScale> per_keyframe;  // by frame
