@@ -81,6 +81,10 @@ def test_run_report_draws_every_panel(run_dir):
     assert color_pixels(image, layout["plot-filter"], "#fab005", tol=20) > 2_000
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
+    # The dataset has depth images: the map's scale against them, one point per keyframe.
+    assert "map_scale" in summary
+    assert "plot-map-scale" in layout
+    assert color_pixels(image, layout["plot-map-scale"], "#0b7285") > 100
     if "ms" in summary["per_frame"][0]:
         assert "plot-timing" in layout
         assert color_pixels(image, layout["plot-timing"], "#ff922b", tol=20) > 2_000

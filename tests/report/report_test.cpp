@@ -110,6 +110,14 @@ void WriteRunFolder(const fs::path& dir, const FixtureOptions& o = {}) {
       {"fps", 20.0},
       {"timing", json::object()},
       {"filter_counts", {{"kept", 300 * kFrames}}},
+      {"map_scale",
+       {{"keyframes", 2},
+        {"median", 1.25},
+        {"p10", 1.2},
+        {"p90", 1.3},
+        {"per_keyframe",
+         {{{"frame", 5}, {"samples", 80}, {"scale", 1.2}},
+          {{"frame", 10}, {"samples", 90}, {"scale", 1.3}}}}}},
       {"per_frame", per_frame}};
   WriteTextFileAtomic(dir / "summary.json", summary.dump(1));
   WriteTumTrajectory(dir / "trajectory.tum", est);
@@ -218,6 +226,11 @@ TEST_F(ReportTest, PerFrameSeriesAndCriticalPath) {
   EXPECT_EQ(frames["keyframe"][5], 1);
   EXPECT_EQ(frames["filter"]["removed_stage1"][kDynamicFrame], 40);
   EXPECT_NEAR(frames["depth_scale"][10].get<double>(), 1.1, 1e-12);
+  // The map's scale at its measured keyframes, null elsewhere.
+  EXPECT_NEAR(frames["map_scale"][5].get<double>(), 1.2, 1e-12);
+  EXPECT_NEAR(frames["map_scale"][10].get<double>(), 1.3, 1e-12);
+  EXPECT_TRUE(frames["map_scale"][6].is_null());
+  EXPECT_EQ(frames["map_scale"].size(), static_cast<size_t>(kFrames));
   const json& cp = data["critical_path"];
   // Main thread 3 + 1 + (10..12) + 5 = 19..21 ms against the worker's 4 + 2 = 6 ms.
   EXPECT_EQ(cp["critical_branch"], "main");
@@ -364,6 +377,11 @@ TEST_F(ReportTest, BadInputNamesTheFile) {
   summary["per_frame"][4].erase("ms");
   WriteTextFileAtomic(run / "summary.json", summary.dump());
   expect_error("per_frame: 'depth' is missing in some frames");
+  WriteRunFolder(run);
+  summary = json::parse(ReadTextFile(run / "summary.json"));
+  summary["map_scale"]["per_keyframe"][1]["scale"] = "tall";
+  WriteTextFileAtomic(run / "summary.json", summary.dump());
+  expect_error("summary.json: map_scale: ");
   WriteRunFolder(run);
   WriteTextFileAtomic(run / "map.ply",
                       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"

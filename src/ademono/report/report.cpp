@@ -304,6 +304,24 @@ json FramesJson(const RunFolder& run, double t0) {
   }
   cols["loop"] = std::move(loop);
   if (any_scale) cols["depth_scale"] = std::move(depth_scale);
+  // The map's scale against the dataset's depth at each measured keyframe (summary.json
+  // `map_scale`, runs on datasets with depth images): null at the other frames.
+  if (run.summary.contains("map_scale")) {
+    json map_scale = json::array();
+    for (size_t k = 0; k < per_frame.size(); ++k) map_scale.push_back(nullptr);
+    try {
+      for (const json& m : run.summary.at("map_scale").at("per_keyframe")) {
+        const int frame = m.at("frame").get<int>();
+        const double scale = m.at("scale").get<double>();
+        for (size_t k = 0; k < per_frame.size(); ++k) {
+          if (cols["frame"][k].get<int>() == frame) map_scale[k] = scale;
+        }
+      }
+    } catch (const json::exception& e) {
+      ThrowInputError(file, std::string("map_scale: ") + e.what());
+    }
+    cols["map_scale"] = std::move(map_scale);
+  }
   return cols;
 }
 

@@ -16,7 +16,7 @@
   window.addEventListener('error', (e) => showError(String(e.message)));
 
   const COLORS = {
-    est: '#e8590c', gt: '#343a40', err: '#c92a2a', scale: '#5f3dc4', inliers: '#1971c2',
+    est: '#e8590c', gt: '#343a40', err: '#c92a2a', scale: '#5f3dc4', mapScale: '#0b7285', inliers: '#1971c2',
     kf: '#1971c2', reloc: '#f08c00', loop: '#9c36b5', lost: 'rgba(224, 49, 49, 0.16)', uninit: 'rgba(134, 142, 150, 0.18)',
   };
   const AXIS_COLORS = ['#d9480f', '#2b8a3e', '#1864ab'];
@@ -413,6 +413,15 @@
         [{ label: 'depth scale', stroke: COLORS.scale, width: 1.5, spanGaps: false, value: (u, v) => fmt(v, 4) }], F, false), [F.t, F.depth_scale]);
     } else {
       errPanel.appendChild(el('div', { class: 'hint' }, 'No per-frame depth scale factor in this run.'));
+    }
+    if (F.map_scale) {
+      // Where the dataset has depth images: the map's own scale per keyframe (1 = metric). Its
+      // spread is the map's scale drift.
+      const box = el('div', { id: 'plot-map-scale' });
+      errPanel.appendChild(box);
+      makePlot(box, 180, timeOpts("The map's scale against the dataset's depth, per keyframe", 'sensor / map',
+        [{ label: 'map scale', stroke: COLORS.mapScale, width: 1.5, spanGaps: true,
+           points: { show: true, size: 6, fill: COLORS.mapScale }, value: (u, v) => fmt(v, 4) }], F, false), [F.t, F.map_scale]);
     }
 
     // Timeline: states, relocalisations, keyframes, inliers.
