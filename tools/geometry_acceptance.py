@@ -12,15 +12,18 @@ held-out windows that start mid-sequence with the same criteria: seqa_late (seq-
 bonn_late (bonn-crowd-a frames 232-463, a start inside the crowd) and kitti_late (KITTI 00 frames
 100-199), `run --frames A:B` as a user would. Each row
 runs twice, `none` and the network; the network row's sim3 is also scored on the frames the none
-run tracked (the "<= 1.1x none" criterion) with `ademono eval`. The office also runs with sensor
-depth (`--depth sensor`, the RGB-D family `run` picks), scored on the none run's frames: the
-geometric mode must be within 1.5x of it. --cache replays `ademono infer`
+run tracked (the "<= 1.1x none" criterion) with `ademono eval`. Every row with depth images
+(seq-a, Bonn, the office and their windows) also runs with sensor depth (`--depth sensor`, the
+RGB-D family `run` picks); on the office it is scored on the none run's frames: the geometric
+mode must be within 1.5x of it. --cache replays `ademono infer`
 caches (made once under OUT/cache) instead of running the networks: faster, the same settings
 family and error model, depths rounded to the cache's millimetres. --ablation adds the variants of
 the new design on seq-a and KITTI (docs/slam.md "Ablation").
 Prints one Markdown table; writes OUT/acceptance.json. "map scale" is summary.json's map_scale:
 the median over keyframes of the dataset's depth against the final map's (the factor that makes
 the map metric, read where the map is, whatever the trajectory's shape; "-" without depth images).
+"shared with sensor" is `ademono eval --shared` of the row's run and the same frames' run with
+sensor depth (RGB-D family): the rms of the error the two have in common, and its correlation.
 """
 import argparse
 import concurrent.futures
@@ -53,8 +56,13 @@ WINDOWS = {"seqa_late": ("seqa", "300:600"), "bonn_late": ("bonn", "232:464"),
            "kitti_late": ("kitti", "100:200")}
 
 
-# Rows that also run with sensor depth (the geometric mode's reference).
-MODES = {"office": ("none", "network", "sensor")}
+# Rows that also run with sensor depth: the geometric mode's reference on the office, and on the
+# real indoor recordings the run whose error the others share ("shared" below): RGB-D SLAM on the
+# sensor's metric depth has no scale to drift, so what the monocular runs share with it is in the
+# images or in the ground truth (docs/evaluation.md "Errors two runs share").
+WITH_SENSOR = ("none", "network", "sensor")
+MODES = {"office": WITH_SENSOR, "seqa": WITH_SENSOR, "bonn": WITH_SENSOR,
+         "seqa_late": WITH_SENSOR, "bonn_late": WITH_SENSOR}
 
 
 def base(row):
@@ -218,6 +226,18 @@ def sim3_on(bin_, network, none, out):
     return results[0]["ape"]["rmse"] if "ape" in results[0] else results[0]["ape_rmse"]
 
 
+def shared_with(bin_, run, other, out):
+    """`ademono eval --shared`: (shared rms, correlation) of run's and other's sim3 errors."""
+    js = os.path.join(out, "shared_with_sensor.json")
+    subprocess.run([bin_, "eval", "--gt", os.path.join(run, "groundtruth.tum"), "--est",
+                    os.path.join(run, "trajectory.tum"), "--est",
+                    os.path.join(other, "trajectory.tum"), "--align", "sim3", "--shared",
+                    "--json", js], check=True, stdout=subprocess.DEVNULL)
+    with open(js) as f:
+        shared = json.load(f)["shared"]
+    return shared["shared_rmse"], shared["correlation"]
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--bin", default=os.path.join(HERE, "build", "release", "bin", "ademono"))
@@ -315,6 +335,9 @@ def main():
                 sensor = sim3_on(a.bin, folders[(r, "sensor")], folders[(r, m)],
                                  folders[(r, "sensor")])
                 row["vs_sensor"] = row["sim3"] / sensor
+            if m != "sensor" and (r, "sensor") in folders and row["sim3"] is not None:
+                row["shared"], row["shared_correlation"] = shared_with(
+                    a.bin, folders[(r, m)], folders[(r, "sensor")], folders[(r, m)])
             c = CRITERIA.get((base(r), m), {})
             fails = []
             if s.get("never_initialised"):
@@ -357,16 +380,19 @@ def main():
     def f(v, fmt="%.4f"):
         return "-" if v is None else fmt % v
     print("| sequence | depth | tracked | first tracked | keyframes | ATE sim3 (m) | ATE se3 (m) "
-          "| sim3 scale | map scale | sim3 on none's frames | / none | frames/s | criteria met |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| sim3 scale | map scale | sim3 on none's frames | / none | shared with sensor (corr.) "
+          "| frames/s | criteria met |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for t in table:
         met = "-" if "met" not in t else ("yes" if t["met"] else "NO: " + ", ".join(t["failed"]))
-        print("| %s | %s | %d/%d | %s | %d | %s | %s | %s | %s | %s | %s | %.1f | %s |" % (
+        shared = ("-" if t.get("shared") is None
+                  else "%.4f (%.2f)" % (t["shared"], t["shared_correlation"]))
+        print("| %s | %s | %d/%d | %s | %d | %s | %s | %s | %s | %s | %s | %s | %.1f | %s |" % (
             t["sequence"], t["depth"], t["tracked"], t["frames"],
             "never" if t.get("never_initialised") else t.get("first_tracked", "-"),
             t["keyframes"], f(t["sim3"]), f(t["se3"]), f(t["scale"], "%.3f"),
             f(t.get("map_scale"), "%.3f"),
-            f(t.get("sim3_on_none_frames")), f(t.get("vs_none"), "%.2f"), t["fps"], met))
+            f(t.get("sim3_on_none_frames")), f(t.get("vs_none"), "%.2f"), shared, t["fps"], met))
     for t in table:
         if "vs_sensor" in t:
             print("\n%s: `--depth none` / sensor depth on the frames none tracked: %.2f (at most %.1f)"
