@@ -114,8 +114,32 @@ TEST_F(GeometricCliTest, GeometryAloneIsWithinOneAndAHalfTimesSensorDepthOnTheOf
   EXPECT_LT(map_scale["p90"].get<double>() / map_scale["p10"].get<double>(), 1.02)
       << "one scale over the whole map (measured 1.003)";
   ASSERT_TRUE(sensor_summary.contains("map_scale"));
-  EXPECT_NEAR(sensor_summary["map_scale"]["median"].get<double>(), 1.0, 0.01)
-      << "measured: 1.000";
+  EXPECT_NEAR(sensor_summary["map_scale"]["median"].get<double>(), 1.0, 0.01) << "measured: 1.000";
+}
+
+TEST_F(GeometricCliTest, DepthImagesTheRunDidNotReadCostOnlyTheMapScaleWhenBroken) {
+  // `--depth none` reads no depth image; the map's scale reads them after the run. Broken ones
+  // cost those keyframes' measurements (a warning each), never the run or its outputs.
+  const fs::path office = dir_ / "office";
+  CliRun r = Run("synth --scene office --motion xyz --frames 60 --seed 7 --out " + office.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string run = "run --dataset tum:" + office.string() + " --config " +
+                          ADEMONO_SOURCE_DIR + "/configs/network_indoor.yaml --depth none --out ";
+  r = Run(run + (dir_ / "intact").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json intact = nlohmann::json::parse(ReadFile(dir_ / "intact" / "summary.json"));
+  ASSERT_TRUE(intact.contains("map_scale")) << "the synthetic office has depth images";
+  for (const auto& entry : fs::directory_iterator(office / "depth")) {
+    std::ofstream(entry.path(), std::ios::trunc) << "not an image";
+  }
+  r = Run(run + (dir_ / "broken").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("map scale: keyframe at frame"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("image does not decode"), std::string::npos) << r.out;
+  const nlohmann::json broken = nlohmann::json::parse(ReadFile(dir_ / "broken" / "summary.json"));
+  EXPECT_FALSE(broken.contains("map_scale"));
+  EXPECT_EQ(ReadFile(dir_ / "broken" / "trajectory.tum"),
+            ReadFile(dir_ / "intact" / "trajectory.tum"));
 }
 
 }  // namespace

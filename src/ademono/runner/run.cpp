@@ -1,9 +1,12 @@
 #include "ademono/runner/run.h"
 
+#include <spdlog/spdlog.h>
+
 #include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
+#include "ademono/core/error.h"
 #include "ademono/core/statistics.h"
 #include "ademono/eval/trajectory_eval.h"
 
@@ -141,8 +144,16 @@ std::optional<MapScaleReport> MeasureMapScale(const Sequence& sequence, const Ma
   for (const auto& [keyframe_id, list] : observations) {
     const size_t frame = keyframes.at(keyframe_id)->index;
     if (frame >= sequence.Size()) continue;
-    if (auto scale = MeasureKeyFrameScale(frame, list, sequence.LoadDepth(frame)))
-      measured.push_back(*scale);
+    // The run did not need this file (its depth came from elsewhere): a broken one costs this
+    // keyframe's measurement, not the run.
+    cv::Mat depth;
+    try {
+      depth = sequence.LoadDepth(frame);
+    } catch (const InputError& e) {
+      spdlog::warn("map scale: keyframe at frame {} not measured: {}", frame, e.what());
+      continue;
+    }
+    if (auto scale = MeasureKeyFrameScale(frame, list, depth)) measured.push_back(*scale);
   }
   return SummarizeMapScale(std::move(measured));
 }
