@@ -32,13 +32,7 @@ FrameData FileSequence::LoadFrame(size_t i, bool with_depth) const {
                                  std::to_string(expected.width) + "x" +
                                  std::to_string(expected.height));
   }
-  if (with_depth && !f.depth.empty()) {
-    frame.depth =
-        DepthToMetres(ReadImage(f.depth, cv::IMREAD_UNCHANGED), spec_.depth_scale, f.depth);
-    if (frame.depth.size() != frame.image.size()) {
-      ThrowInputError(f.depth, "depth image size differs from the colour image size");
-    }
-  }
+  if (with_depth) frame.depth = FileSequence::LoadDepth(i);
   frame.world_from_cam_gt = f.world_from_cam_gt;
   return frame;
 }
@@ -48,6 +42,7 @@ cv::Mat FileSequence::LoadDepth(size_t i) const {
   if (f.depth.empty()) return {};
   cv::Mat depth =
       DepthToMetres(ReadImage(f.depth, cv::IMREAD_UNCHANGED), spec_.depth_scale, f.depth);
+  // The colour image is the camera's size (LoadFrame checks it first).
   if (depth.size() != cv::Size(spec_.camera.width, spec_.camera.height)) {
     ThrowInputError(f.depth, "depth image size differs from the colour image size");
   }

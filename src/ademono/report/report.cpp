@@ -287,16 +287,22 @@ json FramesJson(const RunFolder& run, double t0) {
   }
   cols["filter"] = std::move(filter);
   cols["ms"] = std::move(ms);
+  // The rows of each input frame, for the summary's per-loop and per-keyframe entries.
+  std::map<int, std::vector<size_t>> rows_of_frame;
+  for (size_t k = 0; k < per_frame.size(); ++k)
+    rows_of_frame[cols["frame"][k].get<int>()].push_back(k);
+  auto rows_of = [&](int frame) -> const std::vector<size_t>& {
+    static const std::vector<size_t> kNone;
+    const auto it = rows_of_frame.find(frame);
+    return it == rows_of_frame.end() ? kNone : it->second;
+  };
   // Frames that closed a loop (summary.json `loops`, absent in older runs): 1, else 0.
   json loop = json::array();
   for (size_t k = 0; k < per_frame.size(); ++k) loop.push_back(0);
   if (run.summary.contains("loops")) {
     try {
       for (const json& l : run.summary.at("loops")) {
-        const int query = l.at("query_frame").get<int>();
-        for (size_t k = 0; k < per_frame.size(); ++k) {
-          if (cols["frame"][k].get<int>() == query) loop[k] = 1;
-        }
+        for (size_t k : rows_of(l.at("query_frame").get<int>())) loop[k] = 1;
       }
     } catch (const json::exception& e) {
       ThrowInputError(file, std::string("loops: ") + e.what());
@@ -311,11 +317,8 @@ json FramesJson(const RunFolder& run, double t0) {
     for (size_t k = 0; k < per_frame.size(); ++k) map_scale.push_back(nullptr);
     try {
       for (const json& m : run.summary.at("map_scale").at("per_keyframe")) {
-        const int frame = m.at("frame").get<int>();
         const double scale = m.at("scale").get<double>();
-        for (size_t k = 0; k < per_frame.size(); ++k) {
-          if (cols["frame"][k].get<int>() == frame) map_scale[k] = scale;
-        }
+        for (size_t k : rows_of(m.at("frame").get<int>())) map_scale[k] = scale;
       }
     } catch (const json::exception& e) {
       ThrowInputError(file, std::string("map_scale: ") + e.what());
