@@ -83,6 +83,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("max_frames_between_keyframes", &T::max_frames_between_keyframes)
           .Add("min_keyframe_spacing", &T::min_keyframe_spacing, Range::AtLeast(0))
           .Add("keyframe_ref_ratio", &T::keyframe_ref_ratio, Range::OpenClosed(0, 1))
+          .Add("keyframe_parallax_baseline", &T::keyframe_parallax_baseline)
           .Add("keyframe_ref_min_observations", &T::keyframe_ref_min_observations,
                Range::AtLeast(0))
           .Add("close_tracked_min", &T::close_tracked_min, Range::AtLeast(0))

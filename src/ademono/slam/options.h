@@ -126,6 +126,11 @@ struct TrackingOptions {
   // the whole view, so the close-point rule need not fire every few frames. 0: off (ORB-SLAM).
   int min_keyframe_spacing = 0;
   double keyframe_ref_ratio = 0.75;  // tracked/reference-keyframe point ratio for a new keyframe
+  // Monocular: a new keyframe's baseline to its reference keyframe must give a point at the
+  // median scene depth mapping.triangulation_min_parallax_deg of parallax, the least a new point
+  // is triangulated with. false: mapping.triangulation_min_baseline_ratio alone (ORB-SLAM's 1 %,
+  // a keyframe at a quarter of that parallax adds views but no structure of its own).
+  bool keyframe_parallax_baseline = true;
   // Reference-keyframe points count when seen by this many keyframes (0: ORB-SLAM's 2 or 3).
   int keyframe_ref_min_observations = 0;
   int close_tracked_min = 100;        // fewer tracked close points than this ...

@@ -1054,7 +1054,10 @@ bool Tracking::HasTriangulationBaseline(const Frame& frame) const {
   const double median_depth = Median(depths);
   if (!(median_depth > 0)) return true;
   const double baseline = (frame.CameraCenter() - reference_keyframe_->CameraCenter()).norm();
-  return baseline >= options_.mapping.triangulation_min_baseline_ratio * median_depth;
+  double ratio = options_.mapping.triangulation_min_baseline_ratio;
+  if (options_.tracking.keyframe_parallax_baseline)
+    ratio = std::max(ratio, std::tan(options_.mapping.triangulation_min_parallax_deg * M_PI / 180));
+  return baseline >= ratio * median_depth;
 }
 
 std::shared_ptr<KeyFrame> Tracking::CreateNewKeyFrame(

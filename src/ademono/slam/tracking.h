@@ -155,7 +155,8 @@ class Tracking {
   bool Relocalise(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   bool NeedNewKeyFrame(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
   // Monocular: the frame is far enough from its reference keyframe for new points to be
-  // triangulated (mapping.triangulation_min_baseline_ratio of its median scene depth).
+  // triangulated: mapping.triangulation_min_baseline_ratio of its median scene depth, and with
+  // tracking.keyframe_parallax_baseline the baseline of mapping.triangulation_min_parallax_deg.
   bool HasTriangulationBaseline(const Frame& frame) const ADEMONO_REQUIRES(map_.mutex);
   // `created`: the points made from the frame's own depth (TrackingOutput::created_points).
   std::shared_ptr<KeyFrame> CreateNewKeyFrame(
