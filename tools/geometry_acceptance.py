@@ -280,6 +280,9 @@ def main():
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),
                 (r, "with_enhancement", ["--set", "filter.enable_enhancement=true"]),
                 (r, "unsmoothed_frames", ["--set", "tracking.smooth_trajectory=false"]),
+                # Keyframes at ORB-SLAM's 1 % baseline instead of the parallax new points need.
+                (r, "orb_keyframe_baseline",
+                 ["--set", "tracking.keyframe_parallax_baseline=false"]),
             ]
             # The keyframe scale prior, off in both families, on.
             ablation.append((r, "scale_prior", ["--set", "mapping.network_scale_prior=true"]))
