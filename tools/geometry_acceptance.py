@@ -18,7 +18,12 @@ RGB-D family `run` picks); on the office it is scored on the none run's frames: 
 mode must be within 1.5x of it. --cache replays `ademono infer`
 caches (made once under OUT/cache) instead of running the networks: faster, the same settings
 family and error model, depths rounded to the cache's millimetres. --ablation adds the variants of
-the new design on seq-a and KITTI (docs/slam.md "Ablation").
+the new design on seq-a and KITTI (docs/slam.md "Ablation"). --speed adds the issue's speed
+checks on seq-a, run alone after the table: sensor depth and `--depth none` interleaved three
+times each (median frames/s; none must be at least as fast), and FastDepth + YOLOX-nano run
+inline once (at least 20 frames/s). --soak adds the two soaks (tools/soak_fastdepth.sh with the
+seq-a cache, tools/soak.sh 10000 NetworkDepth) and their checks. Speed figures move with the
+machine's load: measure on an idle machine.
 Prints one Markdown table; writes OUT/acceptance.json. "map scale" is summary.json's map_scale:
 the median over keyframes of the dataset's depth against the final map's (the factor that makes
 the map metric, read where the map is, whatever the trajectory's shape; "-" without depth images).
@@ -247,6 +252,8 @@ def main():
                    default="seqa,bonn,kitti,office,street,seqa_late,bonn_late,kitti_late")
     p.add_argument("--cache", action="store_true")
     p.add_argument("--ablation", action="store_true")
+    p.add_argument("--speed", action="store_true")
+    p.add_argument("--soak", action="store_true")
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=None,
                    help="the distant filter's seed for every run (default: the config's). On KITTI "
@@ -402,9 +409,86 @@ def main():
               for t in table if "vs_sensor" in t]
     if ratios:
         print("\n`--depth none` / sensor depth on the frames none tracked: " + ", ".join(ratios))
+    checks = []
+    if a.speed:
+        checks += speed_checks(a, rows)
+    if a.soak:
+        checks += soak_checks(a)
+    if checks:
+        print("\n| check | measured | bound | met |\n|---|---|---|---|")
+        for c in checks:
+            print("| %s | %s | %s | %s |" % (c["check"], c["measured"], c["bound"],
+                                             "yes" if c["met"] else "NO"))
+        all_ok = all_ok and all(c["met"] for c in checks)
     with open(os.path.join(a.out, "acceptance.json"), "w") as fjs:
-        json.dump(table, fjs, indent=1)
+        json.dump(table + checks, fjs, indent=1)
     return 0 if all_ok else 1
+
+
+def median(values):
+    v = sorted(values)
+    return v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
+
+
+def speed_checks(a, rows):
+    """Issue 28's speed criteria on seq-a, each run alone (nothing else of ours running)."""
+    seq = "7scenes:" + os.path.join(rows.shared, "data", "7scenes-seq-a")
+    fps = {"sensor": [], "none": []}
+    for i in range(3):  # interleaved: the machine's minute-to-minute speed hits both alike
+        for mode in ("sensor", "none"):
+            out = os.path.join(a.out, "speed_%s_%d" % (mode, i))
+            run([a.bin, "run", "--dataset", seq, "--depth", mode, "--out", out, "--overwrite"],
+                out + ".log")
+            fps[mode].append(summary(out)["fps"])
+    sensor, none = median(fps["sensor"]), median(fps["none"])
+    out = os.path.join(a.out, "speed_network")
+    run([a.bin, "run", "--dataset", seq, "--depth", rows.model("seqa"),
+         "--detector", "model:%s/yolox_nano.onnx" % rows.models, "--out", out, "--overwrite"],
+        out + ".log")
+    network = summary(out)["fps"]
+    return [
+        dict(check="seq-a `--depth none` / sensor depth, median frames/s of 3 interleaved runs",
+             measured="%.1f / %.1f = %.2fx" % (none, sensor, none / sensor), bound=">= 1.0x",
+             met=none >= sensor, fps=fps),
+        dict(check="seq-a FastDepth + YOLOX-nano inline, frames/s", measured="%.1f" % network,
+             bound=">= 20", met=network >= 20),
+    ]
+
+
+def soak_checks(a):
+    """The two soaks of issue 28, through their own scripts."""
+    checks = []
+    out = os.path.join(a.out, "soak_fastdepth")
+    cmd = ["bash", os.path.join(HERE, "tools", "soak_fastdepth.sh"), "--out", out,
+           "--bin", a.bin, "--shared", a.shared]
+    cache = os.path.join(a.out, "cache", "seqa", "depth")
+    if os.path.isdir(cache):
+        cmd += ["--cache", cache]
+    run(cmd, out + ".log")
+    with open(out + ".log") as f:
+        for line in f:
+            if line.startswith("keyframes ") or line.startswith("peak RSS growth"):
+                what, _, verdict = line.strip().rpartition(": ")
+                name = "keyframes" if line.startswith("keyframes") else "peak RSS growth"
+                checks.append(dict(check="FastDepth soak on seq-a, 1,000 -> 3,000 frames: " + name,
+                                   measured=what.split(" (")[0],
+                                   bound=what.rpartition("(")[2].rstrip(")"),
+                                   met=verdict == "yes"))
+    log = os.path.join(a.out, "soak_network_depth.log")
+    run(["bash", os.path.join(HERE, "tools", "soak.sh"), "10000", "NetworkDepth"], log)
+    rows_by_frames = {}
+    with open(log) as f:
+        for line in f:
+            parts = line.split()
+            if len(parts) == 9 and parts[0].isdigit():
+                rows_by_frames[int(parts[0])] = float(parts[2])  # frames per CPU second
+    first, last = rows_by_frames.get(1000), rows_by_frames.get(max(rows_by_frames or [0]))
+    if first and last:
+        checks.append(dict(check="`tools/soak.sh 10000 NetworkDepth`: frames per CPU second, "
+                           "last 1k against the first", measured="%.1f -> %.1f (%+.0f %%)" % (
+                               first, last, 100 * (last / first - 1)),
+                           bound="within 20 %", met=abs(last / first - 1) <= 0.2))
+    return checks
 
 
 if __name__ == "__main__":
