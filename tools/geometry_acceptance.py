@@ -34,6 +34,7 @@ import argparse
 import concurrent.futures
 import json
 import os
+import statistics
 import subprocess
 import sys
 
@@ -425,11 +426,6 @@ def main():
     return 0 if all_ok else 1
 
 
-def median(values):
-    v = sorted(values)
-    return v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
-
-
 def speed_checks(a, rows):
     """Issue 28's speed criteria on seq-a, each run alone (nothing else of ours running)."""
     seq = "7scenes:" + os.path.join(rows.shared, "data", "7scenes-seq-a")
@@ -440,7 +436,7 @@ def speed_checks(a, rows):
             run([a.bin, "run", "--dataset", seq, "--depth", mode, "--out", out, "--overwrite"],
                 out + ".log")
             fps[mode].append(summary(out)["fps"])
-    sensor, none = median(fps["sensor"]), median(fps["none"])
+    sensor, none = statistics.median(fps["sensor"]), statistics.median(fps["none"])
     out = os.path.join(a.out, "speed_network")
     run([a.bin, "run", "--dataset", seq, "--depth", rows.model("seqa"),
          "--detector", "model:%s/yolox_nano.onnx" % rows.models, "--out", out, "--overwrite"],
