@@ -119,6 +119,7 @@ void LocalMapping::Solve(Pending& pending) const {
 
 void LocalMapping::Merge() {
   if (!pending_) return;
+  const auto wait_start = std::chrono::steady_clock::now();
   if (pending_->has_ba && options_.threaded) {
     std::unique_lock<std::mutex> lock(job_mutex_);
     job_cv_.wait(lock, [this] { return job_done_; });
@@ -126,6 +127,7 @@ void LocalMapping::Merge() {
   }
   std::unique_ptr<Pending> pending = std::move(pending_);
   if (pending->failure) std::rethrow_exception(pending->failure);
+  const double wait_ms = MsSinceStart(wait_start);  // tracking held up by the BA solve
   const auto start = std::chrono::steady_clock::now();
   const double start_cpu = ThreadCpuMs();
   {
@@ -141,8 +143,9 @@ void LocalMapping::Merge() {
       loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
       loop_closing_->Process(*pending->keyframe);
     }
-    spdlog::debug("keyframe {}: apply + cull {:.1f} ms, loop {:.1f} ms, cpu {:.1f} ms",
-                  pending->keyframe->id, cull_ms, MsSinceStart(start) - cull_ms,
+    spdlog::debug("keyframe {}: waited {:.1f} ms, apply + cull {:.1f} ms, loop {:.1f} ms, "
+                  "cpu {:.1f} ms",
+                  pending->keyframe->id, wait_ms, cull_ms, MsSinceStart(start) - cull_ms,
                   ThreadCpuMs() - start_cpu);
   }
   finished_ms_ += pending->ms + MsSinceStart(start);
