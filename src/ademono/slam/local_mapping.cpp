@@ -594,7 +594,11 @@ void LocalMapping::MeasureNetworkErrors(const Pending& pending) {
     const InverseDepthAffine fit = FitInverseDepthAffine(map_depths, network_depths);
     if (!fit.valid) continue;
     kf.network_fit = fit;
-    if (&kf == pending.keyframe.get()) sigma_logs_.push_back(fit.sigma_log);
+    if (&kf == pending.keyframe.get()) {
+      sigma_logs_.push_back(fit.sigma_log);
+      spdlog::debug("keyframe {}: network error after its affine map {:.3f} (log, {} points)",
+                    kf.id, fit.sigma_log, map_depths.size());
+    }
   }
 }
 
