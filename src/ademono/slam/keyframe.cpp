@@ -19,6 +19,51 @@ void KeyFrame::EraseMapPoint(const MapPoint* point) {
   }
 }
 
+namespace {
+constexpr size_t kScaleSamples = 40;  // a median of 40 ratios: robust to a few moved points
+constexpr size_t kMinScaleSamples = 8;
+}  // namespace
+
+int KeyFrame::SnapshotScale(uint64_t version) {
+  if (bad) return -1;  // no points left to measure with: the pose stays rigid to it
+  if (!scale_snapshots.empty() && scale_snapshots.back().version == version)
+    return static_cast<int>(scale_snapshots.size()) - 1;
+  ScaleSnapshot snapshot;
+  snapshot.version = version;
+  size_t count = 0;
+  for (const auto& p : map_points) count += p && !p->bad;
+  // Evenly over the keyframe's points (deterministic).
+  const size_t stride = std::max<size_t>(1, count / kScaleSamples);
+  size_t k = 0;
+  for (const auto& p : map_points) {
+    if (!p || p->bad) continue;
+    if (k++ % stride != 0) continue;
+    const double z = (cam_from_world * p->position).z();
+    if (z > 0) snapshot.points.emplace_back(p, static_cast<float>(z));
+  }
+  scale_snapshots.push_back(std::move(snapshot));
+  return static_cast<int>(scale_snapshots.size()) - 1;
+}
+
+double KeyFrame::LocalScaleSince(int s) const {
+  if (s < 0 || static_cast<size_t>(s) >= scale_snapshots.size()) return 1.0;
+  const ScaleSnapshot& snapshot = scale_snapshots[static_cast<size_t>(s)];
+  if (bad) return snapshot.scale_at_cull;
+  std::vector<double> ratios;
+  ratios.reserve(snapshot.points.size());
+  for (const auto& [weak, z_then] : snapshot.points) {
+    std::shared_ptr<MapPoint> p = weak.lock();
+    if (p && p->replaced_by) p = MapPoint::Resolve(p);
+    if (!p || p->bad) continue;
+    const double z = (cam_from_world * p->position).z();
+    if (z > 0 && z_then > 0) ratios.push_back(z / z_then);
+  }
+  if (ratios.size() < kMinScaleSamples) return 1.0;
+  auto mid = ratios.begin() + static_cast<long>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), mid, ratios.end());
+  return *mid;
+}
+
 int KeyFrame::TrackedMapPoints(int min_observations) const {
   int n = 0;
   for (const auto& p : map_points) {

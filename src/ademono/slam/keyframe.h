@@ -34,6 +34,17 @@ class KeyFrame {
   KeyFrame* parent = nullptr;
   std::set<KeyFrame*, KeyFrameIdLess> children;
   Rigid3d cam_from_parent = Rigid3d::Identity();  // set when the keyframe is culled
+  // The map's local scale around the keyframe at the moments a pose was stored relative to it
+  // (tracking.follow_local_scale): a sample of its points with their depths in its camera then.
+  // A pose measured in the map's units of then follows a later change of them (local BA moves a
+  // young monocular map by several percent; a loop's Sim(3) rescales it): LocalScaleSince.
+  struct ScaleSnapshot {
+    uint64_t version = 0;  // Map::StructureVersion() when taken
+    std::vector<std::pair<std::weak_ptr<MapPoint>, float>> points;
+    double scale_at_cull = 1.0;  // culled: LocalScaleSince(this) at the cull (points dropped)
+  };
+  std::vector<ScaleSnapshot> scale_snapshots;
+  int parent_snapshot = -1;  // culled: the parent's snapshot taken at the cull
   bool bad = false;
   // Part of a map loaded for localisation only: its pose and its map points never change, it is
   // never culled (temporary keyframes may connect to it in the covisibility graph).
@@ -65,6 +76,13 @@ class KeyFrame {
   }
   void EraseMapPoint(size_t index) { map_points[index].reset(); }
   void EraseMapPoint(const MapPoint* point);
+  // A snapshot of the local scale now (the last one when nothing has moved since `version`);
+  // its index, -1 for a culled keyframe.
+  int SnapshotScale(uint64_t version);
+  // The local scale now over snapshot `s`'s: the median of its points' depths now over then,
+  // among those still in the map. 1 when unknown (s < 0, too few points left); a culled
+  // keyframe's is fixed at its cull.
+  double LocalScaleSince(int s) const;
   // Map points observed by at least `min_observations` keyframes.
   int TrackedMapPoints(int min_observations) const;
   // Recomputes the covisibility edges from the map points (ORB-SLAM's UpdateConnections).

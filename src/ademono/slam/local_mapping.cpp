@@ -494,6 +494,7 @@ void LocalMapping::ApplyBundleAdjustment(const Pending& pending) {
     points[p]->position = result.points[p];
     points[p]->UpdateNormalAndDepth();
   }
+  map_.NoteStructureChange();
 }
 
 void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {

@@ -70,6 +70,12 @@ void Map::ReplacePoint(MapPoint* old_point, const std::shared_ptr<MapPoint>& new
 
 void Map::EraseKeyFrame(KeyFrame* keyframe) {
   if (keyframe == nullptr || keyframe->bad || keyframe->id == 0) return;
+  // Poses stored relative to it keep the local scale's change until now; its points go below.
+  for (size_t s = 0; s < keyframe->scale_snapshots.size(); ++s) {
+    KeyFrame::ScaleSnapshot& snapshot = keyframe->scale_snapshots[s];
+    snapshot.scale_at_cull = keyframe->LocalScaleSince(static_cast<int>(s));
+    std::vector<std::pair<std::weak_ptr<MapPoint>, float>>().swap(snapshot.points);
+  }
   for (KeyFrame* other : std::vector<KeyFrame*>(keyframe->ordered_connections)) {
     other->EraseConnection(keyframe);
   }
@@ -121,6 +127,8 @@ void Map::EraseKeyFrame(KeyFrame* keyframe) {
     keyframe->parent->children.erase(keyframe);
     keyframe->cam_from_parent =
         keyframe->cam_from_world * keyframe->parent->cam_from_world.inverse();
+    if (!keyframe->scale_snapshots.empty())
+      keyframe->parent_snapshot = keyframe->parent->SnapshotScale(structure_version_);
   }
   keyframe->children.clear();
   keyframe->bad = true;
@@ -150,13 +158,18 @@ std::shared_ptr<MapPoint> Map::GetMapPoint(uint64_t id) const {
   return it == points_.end() ? nullptr : it->second;
 }
 
-Rigid3d Map::ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe) {
+Rigid3d Map::ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe,
+                         int snapshot) {
   Rigid3d cam_from_kf = cam_from_keyframe;
+  int s = snapshot;
   int guard = 0;
   while (keyframe->bad && keyframe->parent != nullptr && guard++ < 10000) {
+    if (s >= 0) cam_from_kf.translation() *= keyframe->LocalScaleSince(s);
     cam_from_kf = cam_from_kf * keyframe->cam_from_parent;
+    s = s >= 0 ? keyframe->parent_snapshot : -1;
     keyframe = keyframe->parent;
   }
+  if (s >= 0) cam_from_kf.translation() *= keyframe->LocalScaleSince(s);
   return cam_from_kf * keyframe->cam_from_world;
 }
 
@@ -164,6 +177,9 @@ void Map::Rescale(double factor) {
   auto rescale_keyframe = [factor](KeyFrame& kf) {
     kf.cam_from_world.translation() *= factor;
     kf.cam_from_parent.translation() *= factor;
+    for (auto& snapshot : kf.scale_snapshots) {
+      for (auto& [point, z] : snapshot.points) z *= static_cast<float>(factor);
+    }
     // The keyframe's depths too: local BA's depth residuals would pull the map back.
     kf.features = RescaleDepth(kf.F(), static_cast<float>(factor));
     if (kf.network_fit.valid) kf.network_fit.Rescale(factor);

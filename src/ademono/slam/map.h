@@ -75,10 +75,20 @@ class Map {
   uint64_t NextKeyFrameId() const ADEMONO_REQUIRES(mutex) { return next_keyframe_id_; }
   // Loop closing moved keyframes and points: the tracker re-derives its last pose when this
   // count changes.
-  void NoteLoopCorrection() ADEMONO_REQUIRES(mutex) { ++loop_corrections_; }
+  void NoteLoopCorrection() ADEMONO_REQUIRES(mutex) {
+    ++loop_corrections_;
+    ++structure_version_;
+  }
+  // Counts the changes that move map points (local BA, loop corrections): a keyframe's scale
+  // snapshot of one version stands for all of it.
+  void NoteStructureChange() ADEMONO_REQUIRES(mutex) { ++structure_version_; }
+  uint64_t StructureVersion() const ADEMONO_REQUIRES(mutex) { return structure_version_; }
   uint64_t LoopCorrections() const ADEMONO_REQUIRES(mutex) { return loop_corrections_; }
   // Pose of a (possibly culled) keyframe resolved through the spanning tree: cam_from_world.
-  static Rigid3d ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe);
+  // With `snapshot` (the keyframe's SnapshotScale when `cam_from_keyframe` was measured; -1:
+  // rigid), each link's translation follows the local scale's change since.
+  static Rigid3d ResolvePose(const KeyFrame* keyframe, const Rigid3d& cam_from_keyframe,
+                             int snapshot = -1);
 
  private:
   std::map<uint64_t, std::shared_ptr<KeyFrame>> keyframes_ ADEMONO_GUARDED_BY(mutex);
@@ -88,6 +98,7 @@ class Map {
   uint64_t next_point_id_ ADEMONO_GUARDED_BY(mutex) = 0;
   KeyFrameDatabase* database_ = nullptr;  // set once before the first keyframe
   uint64_t loop_corrections_ ADEMONO_GUARDED_BY(mutex) = 0;
+  uint64_t structure_version_ ADEMONO_GUARDED_BY(mutex) = 0;
 };
 
 }  // namespace ademono

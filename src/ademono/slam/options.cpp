@@ -100,6 +100,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("weak_pose_sets_velocity", &T::weak_pose_sets_velocity)
           .Add("depth_odometry", &T::depth_odometry)
           .Add("interpolate_trajectory", &T::interpolate_trajectory)
+          .Add("follow_local_scale", &T::follow_local_scale)
           .Add("smooth_trajectory", &T::smooth_trajectory)
           .Add("temporary_map", &T::temporary_map);
   return table;

@@ -166,6 +166,10 @@ struct TrackingOptions {
   // blended by time (ResolveFramePose), instead of their reference keyframe's alone. On in
   // network_indoor.yaml, whose young triangulated points move most after a frame is tracked.
   bool interpolate_trajectory = false;
+  // A frame's pose relative to its keyframe is in the map's units of that moment: the
+  // trajectory's frames follow a later change of the local scale around the keyframe (local BA,
+  // a loop's Sim(3)), measured on the keyframe's points (KeyFrame::LocalScaleSince).
+  bool follow_local_scale = false;
   // The trajectory's frames re-estimated after the run under a motion model (a smoothing spline
   // per coordinate, its strength chosen from the run's own poses by cross-validation:
   // optimize/trajectory_smoothing.h). A frame's pose from one image scatters by millimetres

@@ -120,8 +120,9 @@ void Tracking::FollowLoopCorrection() {
   if (records_.empty() || !records_.back().tracked || records_.back().reference == nullptr) return;
   // The velocity is relative and stays; absolute poses follow the reference keyframe.
   recent_good_.clear();
+  const FrameRecord& last = records_.back();
   const Rigid3d corrected =
-      Map::ResolvePose(records_.back().reference, records_.back().cam_from_reference);
+      Map::ResolvePose(last.reference, last.cam_from_reference, last.reference_snapshot);
   if (last_frame_ && last_frame_->cam_from_world) last_frame_->cam_from_world = corrected;
   if (last_good_pose_) last_good_pose_ = corrected;
 }
@@ -350,6 +351,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     record.reference = frame.reference_keyframe;
     record.cam_from_reference =
         *frame.cam_from_world * frame.reference_keyframe->cam_from_world.inverse();
+    if (options_.tracking.follow_local_scale)
+      record.reference_snapshot = frame.reference_keyframe->SnapshotScale(map_.StructureVersion());
     out.tracked = true;
     out.cam_from_world = *frame.cam_from_world;
     out.inliers = matches_inliers_;
@@ -535,12 +538,19 @@ void Tracking::AnchorBetweenKeyFrames(FrameRecord& record, const Rigid3d& cam_fr
   if (new_keyframe != nullptr) {
     // The frames since the last keyframe now have the keyframe after them.
     if (newest_keyframe_ != nullptr) {
+      const int next_snapshot = options_.tracking.follow_local_scale
+                                    ? new_keyframe->SnapshotScale(map_.StructureVersion())
+                                    : -1;
       for (size_t i = newest_keyframe_record_ + 1; i < records_.size(); ++i) {
         FrameRecord& r = records_[i];
         if (!r.tracked || r.previous_keyframe != newest_keyframe_) continue;
         r.next_keyframe = new_keyframe;
-        r.cam_from_next = r.cam_from_previous * newest_keyframe_->cam_from_world *
+        // In the map's units now (the previous keyframe's may have moved since).
+        Rigid3d cam_from_previous = r.cam_from_previous;
+        cam_from_previous.translation() *= newest_keyframe_->LocalScaleSince(r.previous_snapshot);
+        r.cam_from_next = cam_from_previous * newest_keyframe_->cam_from_world *
                           new_keyframe->cam_from_world.inverse();
+        r.next_snapshot = next_snapshot;
       }
     }
     newest_keyframe_ = new_keyframe;
@@ -549,10 +559,13 @@ void Tracking::AnchorBetweenKeyFrames(FrameRecord& record, const Rigid3d& cam_fr
   if (newest_keyframe_ == nullptr) return;
   record.previous_keyframe = newest_keyframe_;
   record.cam_from_previous = cam_from_world * newest_keyframe_->cam_from_world.inverse();
+  if (options_.tracking.follow_local_scale)
+    record.previous_snapshot = newest_keyframe_->SnapshotScale(map_.StructureVersion());
 }
 
 Rigid3d ResolveFramePose(const FrameRecord& record) {
-  const Rigid3d from_reference = Map::ResolvePose(record.reference, record.cam_from_reference);
+  const Rigid3d from_reference =
+      Map::ResolvePose(record.reference, record.cam_from_reference, record.reference_snapshot);
   const KeyFrame* previous = record.previous_keyframe;
   const KeyFrame* next = record.next_keyframe;
   if (previous == nullptr || next == nullptr || next->timestamp <= previous->timestamp) {
@@ -562,8 +575,9 @@ Rigid3d ResolveFramePose(const FrameRecord& record) {
       (record.timestamp - previous->timestamp) / (next->timestamp - previous->timestamp), 0.0,
       1.0);
   const Rigid3d world_from_cam_a =
-      Map::ResolvePose(previous, record.cam_from_previous).inverse();
-  const Rigid3d world_from_cam_b = Map::ResolvePose(next, record.cam_from_next).inverse();
+      Map::ResolvePose(previous, record.cam_from_previous, record.previous_snapshot).inverse();
+  const Rigid3d world_from_cam_b =
+      Map::ResolvePose(next, record.cam_from_next, record.next_snapshot).inverse();
   return InterpolatePose(world_from_cam_a, world_from_cam_b, alpha).inverse();
 }
 

@@ -64,6 +64,11 @@ struct FrameRecord {
   KeyFrame* next_keyframe = nullptr;
   Rigid3d cam_from_next = Rigid3d::Identity();
   double depth_scale = 1.0;  // network depth: the factor its depths were corrected by
+  // tracking.follow_local_scale: each keyframe's scale snapshot when the pose relative to it was
+  // taken (-1: the pose is rigid to the keyframe).
+  int reference_snapshot = -1;
+  int previous_snapshot = -1;
+  int next_snapshot = -1;
 };
 
 // A tracked frame's pose in the map as it is now. With both keyframes around it (between a
