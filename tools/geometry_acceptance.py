@@ -306,11 +306,15 @@ def main():
                                  ["--set", "tracking.interpolate_trajectory=false"]))
                 ablation.append((r, "network_band",
                                  ["--set", "mapping.triangulation_depth_sigmas=3"]))
+                ablation.append((r, "rigid_frames",
+                                 ["--set", "tracking.follow_local_scale=false"]))
             else:
                 ablation.append((r, "interpolated_frames",
                                  ["--set", "tracking.interpolate_trajectory=true"]))
                 ablation.append((r, "no_network_band",
                                  ["--set", "mapping.triangulation_depth_sigmas=0"]))
+                ablation.append((r, "frames_follow_scale",
+                                 ["--set", "tracking.follow_local_scale=true"]))
             if r == "kitti":
                 ablation.append((r, "no_ground_in_ba", ["--set", "depth.ground_in_ba=false"]))
                 ablation.append((r, "held_ground_normal",
