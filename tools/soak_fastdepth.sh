@@ -34,8 +34,9 @@ mkdir -p "$out"
 if [ -z "$cache" ]; then
   cache="$out/cache/depth"
   if [ ! -d "$cache" ]; then
-    "$bin" infer --dataset "7scenes:$seqa" --depth "model:$model,spec=$spec" \
-      --out "$out/cache" > "$out/infer.log" 2>&1
+    "$bin" infer --dataset "7scenes:$seqa" --depth-model "model:$model,spec=$spec" \
+      --out "$out/cache" > "$out/infer.log" 2>&1 ||
+      { echo "soak_fastdepth.sh: ademono infer failed, see $out/infer.log" >&2; exit 1; }
   fi
 fi
 [ -d "$cache" ] || { echo "soak_fastdepth.sh: $cache: no depth cache" >&2; exit 2; }
