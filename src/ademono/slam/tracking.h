@@ -256,7 +256,7 @@ class Tracking {
   // tracking.interpolate_trajectory: `record` (about to be pushed) is anchored to the newest
   // keyframe, and the records since the previous keyframe to `new_keyframe` when one was made.
   void AnchorBetweenKeyFrames(FrameRecord& record, const Rigid3d& cam_from_world,
-                              KeyFrame* new_keyframe);
+                              KeyFrame* new_keyframe) ADEMONO_REQUIRES(map_.mutex);
   std::vector<FrameRecord> records_;
   // The newest keyframe tracking made and the index of its frame's record
   // (tracking.interpolate_trajectory).
