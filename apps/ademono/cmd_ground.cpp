@@ -5,7 +5,10 @@
 //   keypoints  the same to the ORB keypoints with depth in it (what tracking had)
 //   level      the height along the camera's up axis (a level rig), median over the corridor
 //   two-view   the road's homography between frame k and k + --gap under the ground-truth
-//              relative pose (no depth but the start: the level fit), in metres
+//              relative pose (no depth but the start: the level fit), in metres; with
+//              --poses FILE under a run's relative pose instead (its trajectory file, matched by
+//              timestamp), in that trajectory's units (near metres: the level fit in metres
+//              starts the search)
 // each off the detector's boxes.
 #include <fmt/format.h>
 
@@ -15,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
@@ -22,6 +26,7 @@
 #include "ademono/depth/depth_factory.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/feature/orb_extractor.h"
+#include "ademono/io/trajectory.h"
 #include "ademono/io/sequence.h"
 #include "ademono/optimize/ground_plane.h"
 #include "command.h"
@@ -45,7 +50,17 @@ struct GroundArgs {
   double reference_height = 0.0;
   ademono::GroundFromDepthOptions options;
   std::string json;
+  std::string poses;  // two-view: a run's trajectory instead of the ground truth
 };
+
+// The trajectory's pose at `timestamp` (within 1 ms), or nullopt.
+std::optional<ademono::Rigid3d> PoseAt(const ademono::Trajectory& trajectory, double timestamp) {
+  const auto it = std::lower_bound(
+      trajectory.begin(), trajectory.end(), timestamp - 1e-3,
+      [](const ademono::StampedPose& p, double t) { return p.timestamp < t; });
+  if (it == trajectory.end() || std::abs(it->timestamp - timestamp) > 1e-3) return std::nullopt;
+  return it->world_from_cam;
+}
 
 // Pitch (about x, positive: the road's normal leans towards +z, the camera looks down) and roll
 // (about z) of the road's normal in the camera frame, degrees.
@@ -66,8 +81,19 @@ int RunGround(const GroundArgs& args) {
   std::optional<fs::path> camera_yaml;
   if (!args.camera.empty()) camera_yaml = args.camera;
   const auto sequence = ademono::OpenSequence(args.dataset, camera_yaml);
-  if (args.from == "two-view" && !sequence->HasGroundTruth())
-    throw ademono::InputError(args.dataset + ": --from two-view needs ground-truth poses");
+  if (!args.poses.empty() && args.from != "two-view")
+    throw ademono::InputError("--poses is for --from two-view");
+  if (args.from == "two-view" && args.poses.empty() && !sequence->HasGroundTruth())
+    throw ademono::InputError(args.dataset +
+                              ": --from two-view needs ground-truth poses (or --poses FILE)");
+  ademono::Trajectory poses;
+  if (!args.poses.empty()) {
+    if (!fs::is_regular_file(args.poses))
+      throw ademono::InputError(args.poses + ": --poses: no such file");
+    poses = ademono::ReadTrajectory(args.poses, ademono::DetectTrajectoryFormat(args.poses));
+    std::sort(poses.begin(), poses.end(),
+              [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+  }
   const ademono::Camera& camera = sequence->GetCamera();
   ademono::DepthFactoryContext context;
   context.sequence = sequence.get();
@@ -104,8 +130,20 @@ int RunGround(const GroundArgs& args) {
       if (args.from == "two-view") {
         if (j >= sequence->Size()) break;
         const ademono::FrameData other = sequence->Load(j);
-        const ademono::Rigid3d b_from_a =
-            other.world_from_cam_gt->inverse() * *frame.world_from_cam_gt;
+        std::optional<ademono::Rigid3d> world_from_a = frame.world_from_cam_gt;
+        std::optional<ademono::Rigid3d> world_from_b = other.world_from_cam_gt;
+        if (!poses.empty()) {
+          world_from_a = PoseAt(poses, frame.timestamp);
+          world_from_b = PoseAt(poses, other.timestamp);
+        }
+        if (!world_from_a || !world_from_b) {
+          plane = ademono::GroundPlane();  // a frame the run did not track
+          ++total;
+          std::cout << fmt::format("{:5d}  no  (no pose)\n", frame.index);
+          frames.push_back({{"frame", frame.index}, {"valid", false}});
+          continue;
+        }
+        const ademono::Rigid3d b_from_a = world_from_b->inverse() * *world_from_a;
         // The level fit only starts it (its height within about 20 %).
         plane = plane.height > 0 ? ademono::EstimateGroundFromTwoViews(
                                        frame.image, other.image, b_from_a, camera, plane, boxes,
@@ -230,6 +268,9 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--reference-height", args->reference_height,
                      "the rig's camera height (m), to print the median's ratio to it");
       app.add_option("--json", args->json, "write every frame's estimate here");
+      app.add_option("--poses", args->poses,
+                     "two-view: the relative motion from this trajectory (a run's trajectory.tum "
+                     "or .kitti, matched by timestamp) instead of the ground truth");
       return [args] { return RunGround(*args); };
     });
 

@@ -1,6 +1,6 @@
 // KITTI end to end on the real frames in ../shared: `infer` with PyDNet caches depth, `run` from
 // that cache knows the rig's camera height without a flag (and a config key overrides it),
-// `ground` reads the camera's height from the cache frame by frame.
+// `ground` reads the camera's height from the cache frame by frame (under a run's poses too).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <Eigen/Geometry>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
@@ -72,6 +74,55 @@ TEST(KittiCliTest, GroundPrintsEachFramesHeight) {
   r = RunCli("ground --dataset " + kDataset + " --depth " + pydnet + " --from sideways");
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.out, testing::HasSubstr("--from 'sideways'"));
+  fs::remove_all(dir);
+}
+
+// `ground --poses`: the two-view height is in the units of the motion it is given. The ground
+// truth's own poses with every translation 1.1 times as long give a height 1.1 times the ground
+// truth motion's on the same frames (the level fit in metres still starts the search, so units
+// far from metres are out of its reach); a frame the file lacks has no estimate; a missing file
+// is named.
+TEST(KittiCliTest, GroundFromARunsPosesIsInThoseUnits) {
+  const fs::path dir = FreshTempDir("kitti_ground_poses_cli");
+  const std::string pydnet = "model:" + (kShared / "models/pydnet_kitti.onnx").string() +
+                             ",spec=" + ADEMONO_SOURCE_DIR + "/configs/models/pydnet_kitti.yaml";
+  std::ifstream times(kShared / "data/kitti-00/sequences/00/times.txt");
+  std::ifstream poses(kShared / "data/kitti-00/poses/00.txt");
+  std::ofstream longer(dir / "longer.tum");
+  for (int i = 0; i <= 66; ++i) {
+    double t = 0;
+    Eigen::Matrix<double, 3, 4> rt;
+    times >> t;
+    for (int k = 0; k < 12; ++k) poses >> rt(k / 4, k % 4);
+    ASSERT_TRUE(times && poses) << "frame " << i;
+    if (i == 65) continue;  // a frame the run did not track
+    const Eigen::Quaterniond q(Eigen::Matrix3d(rt.leftCols<3>()));
+    const Eigen::Vector3d c = 1.1 * rt.col(3);
+    longer << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.12f} {:.12f} {:.12f} {:.12f}\n", t,
+                           c.x(), c.y(), c.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  longer.close();
+  const std::string common = "ground --dataset " + kDataset + " --depth " + pydnet +
+                             " --from two-view --gap 2 --frames 30:66 --every 35 --json ";
+  CliResult r = RunCli(common + (dir / "gt.json").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  r = RunCli(common + (dir / "longer.json").string() + " --poses " +
+             (dir / "longer.tum").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const nlohmann::json gt = nlohmann::json::parse(ReadFile(dir / "gt.json"));
+  const nlohmann::json longer = nlohmann::json::parse(ReadFile(dir / "longer.json"));
+  ASSERT_EQ(gt["frames"].size(), 2u);  // frames 30 and 65
+  ASSERT_EQ(longer["frames"].size(), 2u);
+  ASSERT_TRUE(gt["frames"][0]["valid"].get<bool>());
+  ASSERT_TRUE(longer["frames"][0]["valid"].get<bool>());
+  EXPECT_NEAR(longer["frames"][0]["height_m"].get<double>() /
+                  gt["frames"][0]["height_m"].get<double>(),
+              1.1, 0.005);
+  EXPECT_FALSE(longer["frames"][1]["valid"].get<bool>());  // no pose at frame 65
+  r = RunCli(common + (dir / "x.json").string() + " --poses " + (dir / "none.tum").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.out, testing::HasSubstr("none.tum"));
+  EXPECT_FALSE(fs::exists(dir / "x.json"));
   fs::remove_all(dir);
 }
 
