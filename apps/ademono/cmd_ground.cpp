@@ -140,7 +140,8 @@ int RunGround(const GroundArgs& args) {
           plane = ademono::GroundPlane();  // a frame the run did not track
           ++total;
           std::cout << fmt::format("{:5d}  no  (no pose)\n", frame.index);
-          frames.push_back({{"frame", frame.index}, {"valid", false}});
+          frames.push_back(
+              {{"frame", frame.index}, {"valid", false}, {"height_m", 0.0}, {"no_pose", true}});
           continue;
         }
         const ademono::Rigid3d b_from_a = world_from_b->inverse() * *world_from_a;

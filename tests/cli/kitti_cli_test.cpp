@@ -88,7 +88,7 @@ TEST(KittiCliTest, GroundFromARunsPosesIsInThoseUnits) {
                              ",spec=" + ADEMONO_SOURCE_DIR + "/configs/models/pydnet_kitti.yaml";
   std::ifstream times(kShared / "data/kitti-00/sequences/00/times.txt");
   std::ifstream poses(kShared / "data/kitti-00/poses/00.txt");
-  std::ofstream longer(dir / "longer.tum");
+  std::ofstream tum(dir / "longer.tum");
   for (int i = 0; i <= 66; ++i) {
     double t = 0;
     Eigen::Matrix<double, 3, 4> rt;
@@ -98,10 +98,10 @@ TEST(KittiCliTest, GroundFromARunsPosesIsInThoseUnits) {
     if (i == 65) continue;  // a frame the run did not track
     const Eigen::Quaterniond q(Eigen::Matrix3d(rt.leftCols<3>()));
     const Eigen::Vector3d c = 1.1 * rt.col(3);
-    longer << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.12f} {:.12f} {:.12f} {:.12f}\n", t,
+    tum << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.12f} {:.12f} {:.12f} {:.12f}\n", t,
                            c.x(), c.y(), c.z(), q.x(), q.y(), q.z(), q.w());
   }
-  longer.close();
+  tum.close();
   const std::string common = "ground --dataset " + kDataset + " --depth " + pydnet +
                              " --from two-view --gap 2 --frames 30:66 --every 35 --json ";
   CliResult r = RunCli(common + (dir / "gt.json").string());
@@ -119,6 +119,7 @@ TEST(KittiCliTest, GroundFromARunsPosesIsInThoseUnits) {
                   gt["frames"][0]["height_m"].get<double>(),
               1.1, 0.005);
   EXPECT_FALSE(longer["frames"][1]["valid"].get<bool>());  // no pose at frame 65
+  EXPECT_TRUE(longer["frames"][1]["no_pose"].get<bool>());
   r = RunCli(common + (dir / "x.json").string() + " --poses " + (dir / "none.tum").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.out, testing::HasSubstr("none.tum"));
