@@ -297,11 +297,12 @@ def main():
                 (r, "orb_keyframe_baseline",
                  ["--set", "tracking.keyframe_parallax_baseline=false"]),
             ]
-            # The keyframe scale prior, off in both families, on.
-            ablation.append((r, "scale_prior", ["--set", "mapping.network_scale_prior=true"]))
-            # Frames between keyframes and the epipolar search's band around the network's depth
-            # differ between the families: each flipped.
+            # Frames between keyframes, the epipolar search's band around the network's depth and
+            # the keyframe scale prior (on indoors, off outdoors) differ between the families:
+            # each flipped.
             if r == "seqa":
+                ablation.append((r, "no_scale_prior",
+                                 ["--set", "mapping.network_scale_prior=false"]))
                 ablation.append((r, "reference_anchor",
                                  ["--set", "tracking.interpolate_trajectory=false"]))
                 ablation.append((r, "network_band",
@@ -309,6 +310,7 @@ def main():
                 ablation.append((r, "rigid_frames",
                                  ["--set", "tracking.follow_local_scale=false"]))
             else:
+                ablation.append((r, "scale_prior", ["--set", "mapping.network_scale_prior=true"]))
                 ablation.append((r, "interpolated_frames",
                                  ["--set", "tracking.interpolate_trajectory=true"]))
                 ablation.append((r, "no_network_band",
