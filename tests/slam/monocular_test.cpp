@@ -54,9 +54,10 @@ SystemOptions Options(DepthInput input) {
   return options;
 }
 
-// `first_index`: the number of the run's first frame (a run need not start at frame 0).
+// `first_index`: the number of the run's first frame (a run need not start at frame 0);
+// `scale_prior`: each keyframe's network scale held in local BA (on, as network_indoor.yaml).
 OfficeRun RunOffice(DepthInput input, size_t frames, const SimulatedDepthOptions& network,
-                    size_t first_index = 0, bool scale_prior = false,
+                    size_t first_index = 0, bool scale_prior = true,
                     bool parallax_baseline = true) {
   const synth::SceneOptions scene_options = Office(frames);
   const synth::Scene scene = synth::BuildScene(scene_options);
