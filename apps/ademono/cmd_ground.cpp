@@ -26,8 +26,9 @@
 #include "ademono/depth/depth_factory.h"
 #include "ademono/detect/detector_factory.h"
 #include "ademono/feature/orb_extractor.h"
-#include "ademono/io/trajectory.h"
 #include "ademono/io/sequence.h"
+#include "ademono/io/timed_poses.h"
+#include "ademono/io/trajectory.h"
 #include "ademono/optimize/ground_plane.h"
 #include "command.h"
 #include "run_options.h"
@@ -52,15 +53,6 @@ struct GroundArgs {
   std::string json;
   std::string poses;  // two-view: a run's trajectory instead of the ground truth
 };
-
-// The trajectory's pose at `timestamp` (within 1 ms), or nullopt.
-std::optional<ademono::Rigid3d> PoseAt(const ademono::Trajectory& trajectory, double timestamp) {
-  const auto it = std::lower_bound(
-      trajectory.begin(), trajectory.end(), timestamp - 1e-3,
-      [](const ademono::StampedPose& p, double t) { return p.timestamp < t; });
-  if (it == trajectory.end() || std::abs(it->timestamp - timestamp) > 1e-3) return std::nullopt;
-  return it->world_from_cam;
-}
 
 // Pitch (about x, positive: the road's normal leans towards +z, the camera looks down) and roll
 // (about z) of the road's normal in the camera frame, degrees.
@@ -133,8 +125,13 @@ int RunGround(const GroundArgs& args) {
         std::optional<ademono::Rigid3d> world_from_a = frame.world_from_cam_gt;
         std::optional<ademono::Rigid3d> world_from_b = other.world_from_cam_gt;
         if (!poses.empty()) {
-          world_from_a = PoseAt(poses, frame.timestamp);
-          world_from_b = PoseAt(poses, other.timestamp);
+          // The run's own pose of each frame (within 1 ms), never one interpolated across frames
+          // it did not track.
+          ademono::PoseLookupOptions lookup;
+          lookup.max_interpolation_gap = 0;
+          lookup.max_nearest_diff = 1e-3;
+          world_from_a = ademono::LookupPose(poses, frame.timestamp, lookup);
+          world_from_b = ademono::LookupPose(poses, other.timestamp, lookup);
         }
         if (!world_from_a || !world_from_b) {
           plane = ademono::GroundPlane();  // a frame the run did not track
