@@ -90,7 +90,6 @@ TEST(MapTest, ACulledKeyFrameKeepsItsPoseLinkButNotItsKeypoints) {
   EXPECT_EQ(features->Size(), 2u);  // the frame's own features are untouched
 }
 
-
 TEST(MapTest, APoseFollowsTheLocalScaleAroundItsKeyFrame) {
   // A frame's pose relative to its keyframe is measured in the map's units of that moment. When
   // local BA or a loop later rescales the map around the keyframe, the pose follows (and through
@@ -113,9 +112,8 @@ TEST(MapTest, APoseFollowsTheLocalScaleAroundItsKeyFrame) {
   kf1->parent = kf0.get();
   kf0->children.insert(kf1.get());
   for (size_t i = 0; i < pixels.size(); ++i) {
-    auto p = map.CreateMapPoint(
-        Eigen::Vector3d(0.05 * static_cast<double>(i) - 0.5, 0.1, 2.0 + 0.1 * static_cast<double>(i)),
-        kf1.get(), 1);
+    const double x = static_cast<double>(i);
+    auto p = map.CreateMapPoint(Eigen::Vector3d(0.05 * x - 0.5, 0.1, 2.0 + 0.1 * x), kf1.get(), 1);
     p->AddObservation(kf0.get(), i);
     p->AddObservation(kf1.get(), i);
     kf0->AddMapPoint(p, i);
@@ -124,7 +122,8 @@ TEST(MapTest, APoseFollowsTheLocalScaleAroundItsKeyFrame) {
   kf0->UpdateConnections();
   kf1->UpdateConnections();
   auto scale_about = [&map](const Eigen::Vector3d& centre, double factor) {
-    for (const auto& [id, p] : map.MapPoints()) p->position = centre + factor * (p->position - centre);
+    for (const auto& [id, p] : map.MapPoints())
+      p->position = centre + factor * (p->position - centre);
     map.NoteStructureChange();
   };
 
