@@ -996,12 +996,15 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
     return false;
   }
   if (reference_keyframe_ == nullptr) return true;
-  // Monocular: a map of one keyframe (made from depth) has only single-view points; they count
-  // (else no keyframe would ever come: RGB-D has the close-point rule for that).
-  const int min_obs = t.keyframe_ref_min_observations > 0    ? t.keyframe_ref_min_observations
-                      : t.monocular && map_.NumKeyFrames() <= 1 ? 1
-                      : map_.NumKeyFrames() <= 2          ? 2
-                                                          : 3;
+  // ORB-SLAM's count: the reference's points seen by 3 keyframes (2 in a map of two). Monocular:
+  // a point can be seen by no more keyframes than the reference and those sharing points with it.
+  // A map of one keyframe (made from depth) or a restart's first keyframe in the same map has
+  // single-view points only, and they count, else no keyframe would ever come after it (RGB-D has
+  // the close-point rule for that).
+  int min_obs = map_.NumKeyFrames() <= 2 ? 2 : 3;
+  if (t.monocular)
+    min_obs = std::min(min_obs, 1 + static_cast<int>(reference_keyframe_->BestCovisibles(2).size()));
+  if (t.keyframe_ref_min_observations > 0) min_obs = t.keyframe_ref_min_observations;
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
 
