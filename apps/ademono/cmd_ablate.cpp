@@ -61,7 +61,7 @@ int Ablate(const AblateArgs& args) {
   const fs::path config_path = ResolveConfigPath(args.config, *sequence, args.depth);
   const YAML::Node config = LoadConfig(config_path, args.set);
   AblationOptions options;
-  options.system = SystemOptions::FromYaml(config, config_path);
+  options.system = SystemOptionsFromConfig(config, config_path, args.set);
   ApplyDepthSource(args.depth, options.system);
   ApplyDatasetCameraHeight(config, *sequence, options.system);
   options.variants = variants;

@@ -139,7 +139,7 @@ int Run(const RunArgs& args) {
   // Config: --config or the dataset family's default.
   const fs::path config_path = ResolveConfigPath(args.config, *sequence, args.depth);
   const YAML::Node config = LoadConfig(config_path, args.set);
-  SystemOptions options = SystemOptions::FromYaml(config, config_path);
+  SystemOptions options = SystemOptionsFromConfig(config, config_path, args.set);
   ApplyDepthSource(args.depth, options);
   ApplyDatasetCameraHeight(config, *sequence, options);
   const DetectorOptions detector_options = DetectorOptionsFromConfig(config, config_path);

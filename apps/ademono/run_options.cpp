@@ -173,6 +173,19 @@ YAML::Node LoadConfig(const fs::path& path, const std::vector<std::string>& over
   return LoadConfigWithOverrides(path, overrides);
 }
 
+SystemOptions SystemOptionsFromConfig(const YAML::Node& config, const fs::path& path,
+                                      const std::vector<std::string>& overrides) {
+  try {
+    return SystemOptions::FromYaml(config, path);
+  } catch (const InputError&) {
+    if (overrides.empty()) throw;
+    SystemOptions::FromYaml(LoadConfigWithOverrides(path), path);  // the file's own error
+    std::string label = "--set";
+    for (const std::string& item : overrides) label += " " + item;
+    return SystemOptions::FromYaml(config, label);
+  }
+}
+
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config, const fs::path& config_path) {
   try {
     return DetectorOptions::FromYaml(config["detector"]);

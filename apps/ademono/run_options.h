@@ -65,6 +65,11 @@ void ApplyDatasetCameraHeight(const YAML::Node& config, const Sequence& sequence
 // readers then reject unknown ones as they would in the file.
 YAML::Node LoadConfig(const std::filesystem::path& path,
                       const std::vector<std::string>& overrides = {});
+// SystemOptions::FromYaml of `config`, the file at `path` with `overrides` applied. An error the
+// file alone does not have came from the overrides: the InputError names them ("--set ...: ...")
+// rather than the file.
+SystemOptions SystemOptionsFromConfig(const YAML::Node& config, const std::filesystem::path& path,
+                                      const std::vector<std::string>& overrides);
 // The `detector:` node (DetectorOptions::FromYaml); InputError naming the file and the key.
 DetectorOptions DetectorOptionsFromConfig(const YAML::Node& config,
                                           const std::filesystem::path& config_path);

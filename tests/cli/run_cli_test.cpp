@@ -169,6 +169,12 @@ TEST_F(RunCliTest, BadInputsFailWithOneLineAndNoOutput) {
       {"--frames 0:5 --depth cache:/nonexistent/depth", "/nonexistent/depth"},
       {"--frames 0:5 --depth warp", "unknown depth provider"},
       {"--frames 0:5 --seed abc", "--seed"},
+      // An override's mistake names the override, not the config file it was applied to.
+      {"--frames 0:5 --set tracking.bogus=1",
+       "--set tracking.bogus=1: unknown key 'tracking.bogus'"},
+      {"--frames 0:5 --set tracking.min_inliers=lots", "--set tracking.min_inliers=lots: "},
+      {"--frames 0:5 --config " + bad_detector.string() + " --set tracking.min_inliers=30",
+       bad_detector.string() + ": unknown key 'detector.score_treshold'"},
   };
   for (const Case& c : cases) {
     const CliResult r =

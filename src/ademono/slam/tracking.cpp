@@ -1002,8 +1002,10 @@ bool Tracking::NeedNewKeyFrame(const Frame& frame) const {
   // single-view points only, and they count, else no keyframe would ever come after it (RGB-D has
   // the close-point rule for that).
   int min_obs = map_.NumKeyFrames() <= 2 ? 2 : 3;
-  if (t.monocular)
-    min_obs = std::min(min_obs, 1 + static_cast<int>(reference_keyframe_->BestCovisibles(2).size()));
+  if (t.monocular) {
+    const int covisibles = static_cast<int>(reference_keyframe_->BestCovisibles(2).size());
+    min_obs = std::min(min_obs, 1 + covisibles);
+  }
   if (t.keyframe_ref_min_observations > 0) min_obs = t.keyframe_ref_min_observations;
   const int ref_matches = reference_keyframe_->TrackedMapPoints(min_obs);
   const bool idle = local_mapping_.Idle();
