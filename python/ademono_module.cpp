@@ -201,6 +201,8 @@ struct PyTrackResult {
   std::string state;
   bool new_keyframe = false;
   int num_keypoints = 0, num_kept = 0, num_with_depth = 0, inliers = 0;
+  double depth_scale = 1.0;
+  std::optional<double> scale_sigma;
   py::object keypoints;  // (N, 2) float32 pixel positions of all extracted keypoints
 };
 
@@ -288,6 +290,8 @@ class PySystem {
     out.num_kept = r.num_kept;
     out.num_with_depth = r.num_with_depth;
     out.inliers = r.inliers;
+    out.depth_scale = r.depth_scale;
+    out.scale_sigma = r.scale_sigma;
     py::array_t<float> kp({static_cast<py::ssize_t>(r.keypoints.size()), py::ssize_t{2}});
     auto k = kp.mutable_unchecked<2>();
     for (size_t i = 0; i < r.keypoints.size(); ++i) {
@@ -557,6 +561,11 @@ PYBIND11_MODULE(ademono, m) {
       .def_readonly("num_kept", &PyTrackResult::num_kept)
       .def_readonly("num_with_depth", &PyTrackResult::num_with_depth)
       .def_readonly("inliers", &PyTrackResult::inliers)
+      .def_readonly("depth_scale", &PyTrackResult::depth_scale,
+                    "network depth: the factor this frame's depths were corrected by (1 otherwise)")
+      .def_readonly("scale_sigma", &PyTrackResult::scale_sigma,
+                    "network depth or a ground scale: the relative standard error of the run's "
+                    "metric scale as this frame leaves it; None otherwise")
       .def_readonly("keypoints", &PyTrackResult::keypoints);
 
   py::class_<PySystem>(m, "System", "The SLAM system: call track() once per frame, in order")

@@ -67,6 +67,8 @@ def test_tracking_through_python_is_byte_identical_to_the_cli(tmp_path):
         frame = seq[i]
         r = system.track(frame.image, depth=frame.depth, timestamp=frame.timestamp)
         states.append(r.state)
+        # Sensor depth: metric already, nothing corrected and no scale to be unsure of.
+        assert r.depth_scale == 1.0 and r.scale_sigma is None
         if r.tracked:
             assert r.cam_from_world.shape == (4, 4)
             np.testing.assert_allclose(r.cam_from_world[3], [0, 0, 0, 1])

@@ -173,6 +173,12 @@ TEST(KittiCliTest, ADriveAtTwiceTheSpeedKeepsItsScale) {
     EXPECT_LT(accuracy["ate_sim3_rmse_m"].get<double>(), 0.5) << "seed " << seed;
     EXPECT_LT(accuracy["ate_se3_rmse_m"].get<double>(), 1.0) << "seed " << seed;  // of 87 m
     EXPECT_NEAR(accuracy["sim3_scale"].get<double>(), 1.0, 0.05) << "seed " << seed;
+    // The road gave the scale, and says how well it pinned it down.
+    EXPECT_EQ(summary["metric_scale"]["source"], "ground") << "seed " << seed;
+    const double sigma = summary["metric_scale"]["sigma"].get<double>();
+    EXPECT_GT(sigma, 0.0) << "seed " << seed;
+    EXPECT_LT(sigma, 0.02) << "seed " << seed;
+    EXPECT_TRUE(summary["per_frame"][59].contains("scale_sigma")) << "seed " << seed;
   }
   fs::remove_all(dir);
 }

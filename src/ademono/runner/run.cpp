@@ -205,6 +205,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
     f.geometric_dynamic = r.geometric_dynamic;
     f.geometric_culled = r.geometric_culled;
     f.filter = r.filter_stats;
+    f.scale_sigma = r.scale_sigma;
     report.per_frame.push_back(f);
     report.filter_totals.Add(r.filter_stats, r.num_keypoints);
     if (score)
@@ -350,6 +351,16 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                         {"p10", Percentile(depth_scales, 0.1)},
                         {"p90", Percentile(depth_scales, 0.9)}};
   }
+  std::optional<double> scale_sigma;
+  for (const FrameReport& f : report.per_frame) {
+    if (f.scale_sigma) scale_sigma = f.scale_sigma;
+  }
+  if (scale_sigma) {
+    // How well the run pinned its scale source down (the last frame's per_frame[].scale_sigma:
+    // relative standard error; the source's own bias is not in it, docs/slam.md).
+    j["metric_scale"] = {{"source", o.depth.GroundScale() ? "ground" : "network"},
+                         {"sigma", *scale_sigma}};
+  }
   if (report.map_scale) {
     // The map's metric scale read where the map is: the factor from its depths to the dataset's
     // depth images, per keyframe (1 = metric; compare accuracy.sim3_scale).
@@ -408,6 +419,7 @@ nlohmann::json RunSummaryJson(const RunReport& report) {
                            {"tracking_thread_cpu", f.ms.tracking_thread_ms},
                            {"prefetch_thread_cpu", f.ms.prefetch_thread_ms}}}});
     if (f.depth_scale) per_frame.back()["depth_scale"] = *f.depth_scale;
+    if (f.scale_sigma) per_frame.back()["scale_sigma"] = *f.scale_sigma;
   }
   j["per_frame"] = std::move(per_frame);
   nlohmann::json loops = nlohmann::json::array();

@@ -60,6 +60,8 @@ struct FrameReport {
   // Network depth: the factor its depths were corrected by, against the final map (absent for
   // sensor depth and untracked frames).
   std::optional<double> depth_scale;
+  // The relative standard error of the run's metric scale as the frame left it (TrackResult).
+  std::optional<double> scale_sigma;
   FilterStats filter;
   FrameTiming ms;
 };

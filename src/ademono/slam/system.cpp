@@ -81,6 +81,7 @@ TrackResult System::TrackFrame(const FrameData& frame, const cv::Mat& depth,
     if (k < extracted_index.size()) result.created_points.emplace_back(extracted_index[k], point);
   }
   result.depth_scale = out.depth_scale;
+  result.scale_sigma = out.scale_sigma;
   if (out.tracked) result.cam_from_world = out.cam_from_world;
   result.new_keyframe = back.new_keyframe;
   result.keypoints = std::move(extracted.keypoints);

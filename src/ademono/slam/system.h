@@ -38,6 +38,9 @@ struct TrackResult {
   int geometric_dynamic = 0;  // matched map points the geometric test judged moving
   int geometric_culled = 0;   // map points it culled
   double depth_scale = 1.0;       // network depth: this frame's scale correction
+  // Network depth or a ground scale: the relative standard error of the run's metric scale as
+  // this frame leaves it (Tracking::ScaleSigma); none for sensor depth and `--depth none`.
+  std::optional<double> scale_sigma;
   FilterStats filter_stats;
   std::vector<cv::KeyPoint> keypoints;  // all extracted keypoints ...
   std::vector<PointLabel> labels;       // ... and their filter labels (for --viz)

@@ -361,9 +361,13 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
     out.depth_scale = record.depth_scale = frame.F().depth_scale;
     if (frame.F().DepthIsPrior()) {
       last_depth_scale_ = frame.F().depth_scale;
-      log_scale_sum_ += std::log(last_depth_scale_);
+      const double x = std::log(last_depth_scale_);
+      const double mean_before = log_scale_count_ > 0 ? log_scale_sum_ / log_scale_count_ : 0.0;
+      log_scale_sum_ += x;
       ++log_scale_count_;
+      log_scale_m2_ += (x - mean_before) * (x - log_scale_sum_ / log_scale_count_);
     }
+    out.scale_sigma = ScaleSigma();
   } else if (state_ != TrackingState::kNotInitialized) {
     ++num_lost_;
   }
@@ -476,6 +480,27 @@ void Tracking::AnchorScale(Frame& frame) {
   const double mean = (log_scale_sum_ + std::log(frame.F().depth_scale)) / (log_scale_count_ + 1);
   if (std::abs(mean) <= options_.depth.anchor_tolerance) return;
   RescaleWorld(frame, std::exp(-mean));
+}
+
+std::optional<double> Tracking::ScaleSigma() {
+  if (map_loaded_) return std::nullopt;  // the loaded map's scale: nothing this run estimated
+  if (options_.depth.GroundScale()) {
+    if (ground_heights_.size() < 3) return std::nullopt;
+    if (ground_spread_samples_ != ground_heights_.size()) {
+      // A rescale multiplies every height alike: the spread of their logs stays.
+      std::vector<double> logs;
+      for (double h : ground_heights_) logs.push_back(std::log(h));
+      ground_log_spread_ = RobustSpread(logs, Median(logs));
+      ground_spread_samples_ = ground_heights_.size();
+    }
+    return ground_log_spread_ / std::sqrt(static_cast<double>(ground_heights_.size()));
+  }
+  if (!options_.depth.IsPrior() || !options_.depth.anchor_scale || log_scale_count_ < 2)
+    return std::nullopt;
+  const double spread = std::sqrt(log_scale_m2_ / (log_scale_count_ - 1));
+  const size_t views =
+      std::clamp<size_t>(map_.NumKeyFrames(), 1, static_cast<size_t>(log_scale_count_));
+  return spread / std::sqrt(static_cast<double>(views));
 }
 
 std::optional<double> Tracking::MeasureGround(const Frame& frame, bool map_points,

@@ -98,6 +98,8 @@ struct TrackingOutput {
   // a run, whether those keypoints entered the map. Empty unless the frame became a keyframe.
   std::vector<std::pair<size_t, std::shared_ptr<const MapPoint>>> created_points;
   double depth_scale = 1.0;  // network depth: this frame's scale correction (1 for sensor depth)
+  // The relative standard error of the run's metric scale as this frame leaves it (ScaleSigma).
+  std::optional<double> scale_sigma;
 };
 
 class Tracking {
@@ -197,6 +199,13 @@ class Tracking {
   // Keeps the map at the network's long-run mean scale, or with depth.camera_height at the scale
   // that puts the camera camera_height above the ground (rescales the world when it drifted).
   void AnchorScale(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
+  // The relative standard error of the metric scale the run holds now. Ground scale: the robust
+  // spread of the keyframes' camera heights over sqrt(their count). Network depth (anchored to
+  // its long-run mean): the spread of the frames' log corrections over sqrt(the keyframes), the
+  // map's independent views (the frames between two keyframes see one view, and the network errs
+  // alike on it). Neither holds the source's own bias (a network reading a room short, a wrong
+  // rig height): it says how well the run pinned its scale source down, not how right that is.
+  std::optional<double> ScaleSigma() ADEMONO_REQUIRES(map_.mutex);
   // depth.camera_height: the camera's height above the ground plane fitted to the frame's
   // keypoints below the horizon, off dynamic boxes and in the corridor ahead: on the map points
   // they track (`map_points`, map units: the map's own scale, whatever biased it) or on their
@@ -237,6 +246,10 @@ class Tracking {
   double last_depth_scale_ = 1.0;  // the last tracked frame's network scale correction
   double log_scale_sum_ = 0.0;     // sum of log(depth_scale) over tracked frames
   int log_scale_count_ = 0;
+  double log_scale_m2_ = 0.0;  // their sum of squared deviations from the mean (Welford)
+  // ScaleSigma's robust spread of log ground_heights_, and how many heights it was read from.
+  double ground_log_spread_ = 0.0;
+  size_t ground_spread_samples_ = 0;
   std::vector<double> ground_heights_;  // depth.camera_height: GroundHeights()
   std::vector<size_t> ground_height_frames_;
   bool map_loaded_ = false;
