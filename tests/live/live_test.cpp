@@ -133,6 +133,13 @@ TEST(FoxgloveTest, FrameMessages) {
   EXPECT_EQ(stats["state"], "ok");
   EXPECT_EQ(stats["labels"]["kept"], 2);
   EXPECT_TRUE(stats["depth_scale"].is_null());
+  EXPECT_TRUE(stats["scale_sigma"].is_null());
+  LiveFrame scaled = TestFrame(8);
+  scaled.depth_scale = 1.1;
+  scaled.scale_sigma = 0.02;
+  const json scaled_stats = json::parse(FrameStatsJson(scaled));
+  EXPECT_DOUBLE_EQ(scaled_stats["depth_scale"].get<double>(), 1.1);
+  EXPECT_DOUBLE_EQ(scaled_stats["scale_sigma"].get<double>(), 0.02);
   const json annotations = json::parse(ImageAnnotationsJson(f));
   ASSERT_EQ(annotations["points"].size(), 3u);  // kept, stage 1, the box
   EXPECT_EQ(annotations["points"][0]["points"].size(), 2u);

@@ -288,6 +288,7 @@ std::string FrameStatsJson(const LiveFrame& frame) {
               {"with_depth", frame.with_depth},
               {"inliers", frame.inliers},
               {"depth_scale", frame.depth_scale ? json(*frame.depth_scale) : json(nullptr)},
+              {"scale_sigma", frame.scale_sigma ? json(*frame.scale_sigma) : json(nullptr)},
               {"labels", std::move(labels)},
               {"boxes", frame.detections.size()},
               {"ms",

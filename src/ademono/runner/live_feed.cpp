@@ -59,6 +59,7 @@ void LiveFeed::Frame(const System& system, const FrameData& frame,
     f.inliers = r.inliers;
     const FrameDepthOptions& depth = system.Options().depth;
     if (r.tracked && (depth.IsPrior() || depth.GroundScale())) f.depth_scale = r.depth_scale;
+    f.scale_sigma = r.scale_sigma;
     f.extraction_ms = r.extraction_ms;
     f.keypoint_depth_ms = r.keypoint_depth_ms;
     f.filter_ms = r.filter_ms;

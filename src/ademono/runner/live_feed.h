@@ -31,6 +31,7 @@ struct LiveFrame {
   std::optional<Rigid3d> cam_from_world;
   int keypoints = 0, kept = 0, with_depth = 0, inliers = 0;
   std::optional<double> depth_scale;  // network depth (or a ground scale): this frame's factor
+  std::optional<double> scale_sigma;  // ... and the metric scale's relative standard error
   // Wall milliseconds of the stages the frame's TrackResult measured.
   double extraction_ms = 0, keypoint_depth_ms = 0, filter_ms = 0, tracking_ms = 0, mapping_ms = 0;
   std::vector<cv::Point2f> points;  // every extracted keypoint ...

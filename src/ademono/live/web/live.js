@@ -278,6 +278,8 @@
       parts.push('frame ' + lastFrame.frame + ' (' + lastFrame.state + (lastFrame.keyframe ? ', keyframe' : '') + ')');
       parts.push('inliers ' + lastFrame.inliers);
       if (lastFrame.depth_scale !== null) parts.push('depth scale ' + fmt(lastFrame.depth_scale, 3));
+      if (lastFrame.scale_sigma !== null && lastFrame.scale_sigma !== undefined)
+        parts.push('metric scale ± ' + fmt(100 * lastFrame.scale_sigma, 1) + ' %');
     }
     if (live.cloud) parts.push(live.cloud.count + ' map points');
     parts.push(live.keyframes.length + ' keyframes');
