@@ -90,6 +90,7 @@ void WriteRunFolder(const fs::path& dir, const FixtureOptions& o = {}) {
           {{"extraction", 3.0}, {"depth", 4.0}, {"detection", 2.0}, {"filter", 1.0},
            {"tracking", 10.0 + (i % 3)}, {"mapping", 5.0}}},
          {"depth_scale", 1.0 + 0.01 * i}});
+    if (i >= 2 && !lost) per_frame.back()["scale_sigma"] = 0.1 / i;
   }
   json summary = {
       {"schema", "ademono.run/1"},
@@ -226,6 +227,11 @@ TEST_F(ReportTest, PerFrameSeriesAndCriticalPath) {
   EXPECT_EQ(frames["keyframe"][5], 1);
   EXPECT_EQ(frames["filter"]["removed_stage1"][kDynamicFrame], 40);
   EXPECT_NEAR(frames["depth_scale"][10].get<double>(), 1.1, 1e-12);
+  // The metric scale's confidence where a frame reported it, null elsewhere.
+  EXPECT_NEAR(frames["scale_sigma"][10].get<double>(), 0.01, 1e-12);
+  EXPECT_TRUE(frames["scale_sigma"][0].is_null());
+  EXPECT_TRUE(frames["scale_sigma"][30].is_null());  // lost
+  EXPECT_EQ(frames["scale_sigma"].size(), static_cast<size_t>(kFrames));
   // The map's scale at its measured keyframes, null elsewhere.
   EXPECT_NEAR(frames["map_scale"][5].get<double>(), 1.2, 1e-12);
   EXPECT_NEAR(frames["map_scale"][10].get<double>(), 1.3, 1e-12);

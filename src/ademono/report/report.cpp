@@ -231,7 +231,8 @@ json FramesJson(const RunFolder& run, double t0) {
   cols["weak"] = json::array();  // 0 good (or untracked), 1 few static points, 2 motion model, 3
                                  // depth odometry
   json filter = json::object(), ms = json::object(), depth_scale = json::array();
-  bool any_scale = false;
+  json scale_sigma = json::array();  // the metric scale's relative standard error, per frame
+  bool any_scale = false, any_sigma = false;
   size_t i = 0;
   for (const json& f : per_frame) {
     const std::string where = "per_frame[" + std::to_string(i) + "]";
@@ -272,6 +273,12 @@ json FramesJson(const RunFolder& run, double t0) {
       } else {
         depth_scale.push_back(nullptr);
       }
+      if (f.contains("scale_sigma") && !f["scale_sigma"].is_null()) {
+        scale_sigma.push_back(f["scale_sigma"].get<double>());
+        any_sigma = true;
+      } else {
+        scale_sigma.push_back(nullptr);
+      }
     } catch (const json::exception& e) {
       ThrowInputError(file, where + ": " + e.what());
     }
@@ -310,6 +317,7 @@ json FramesJson(const RunFolder& run, double t0) {
   }
   cols["loop"] = std::move(loop);
   if (any_scale) cols["depth_scale"] = std::move(depth_scale);
+  if (any_sigma) cols["scale_sigma"] = std::move(scale_sigma);
   // The map's scale against the dataset's depth at each measured keyframe (summary.json
   // `map_scale`, runs on datasets with depth images): null at the other frames.
   if (run.summary.contains("map_scale")) {
@@ -505,7 +513,7 @@ json SummaryJson(const RunFolder& run) {
   for (const char* k :
        {"dataset", "config", "depth", "detector", "seed", "deterministic", "filters", "frames",
         "tracked", "untracked", "lost", "keyframes", "map_points", "wall_seconds", "fps", "timing",
-        "filter_counts", "accuracy"}) {
+        "filter_counts", "accuracy", "metric_scale"}) {
     if (run.summary.contains(k)) s[k] = run.summary[k];
   }
   return s;

@@ -359,6 +359,10 @@
       cards.appendChild(card(fmt(acc.ate_sim3_rmse_m, 4) + ' m', 'ATE sim3 RMSE (scale ' + fmt(acc.sim3_scale, 3) + ')'));
       cards.appendChild(card(fmt(acc.rpe_30_frames_trans_rmse_m, 4) + ' m', 'RPE 30 frames'));
     }
+    if (S.metric_scale) {
+      cards.appendChild(card('± ' + fmt(100 * S.metric_scale.sigma, 1) + ' %',
+        'metric scale (' + (S.metric_scale.source === 'ground' ? 'the road' : 'the network') + '), its bias aside'));
+    }
     app.appendChild(cards);
 
     // Trajectory.
@@ -413,6 +417,15 @@
         [{ label: 'depth scale', stroke: COLORS.scale, width: 1.5, spanGaps: false, value: (u, v) => fmt(v, 4) }], F, false), [F.t, F.depth_scale]);
     } else {
       errPanel.appendChild(el('div', { class: 'hint' }, 'No per-frame depth scale factor in this run.'));
+    }
+    if (F.scale_sigma) {
+      // How well the run pinned its scale source down as it went (not the source's own bias).
+      const box = el('div', { id: 'plot-scale-sigma' });
+      errPanel.appendChild(box);
+      const opts = timeOpts("The metric scale's relative standard error, as each frame left it", '%',
+        [{ label: 'scale sigma', stroke: COLORS.scale, width: 1.5, spanGaps: false, value: (u, v) => fmt(v, 2) }], F, false);
+      opts.scales.y = { range: (u, min, max) => [0, max > 0 ? max * 1.1 : 1] };
+      makePlot(box, 150, opts, [F.t, F.scale_sigma.map((v) => (v === null ? null : 100 * v))]);
     }
     if (F.map_scale) {
       // Where the dataset has depth images: the map's own scale per keyframe (1 = metric). Its
