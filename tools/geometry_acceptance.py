@@ -11,7 +11,9 @@ Rows: seqa (7-Scenes seq-a, FastDepth), bonn (bonn-crowd-a, FastDepth + YOLOX-na
 (KITTI 00 frames 0-199, PyDNet), office and street (synthetic, the simulated network), and two
 held-out windows that start mid-sequence with the same criteria: seqa_late (seq-a frames 300-599),
 bonn_late (bonn-crowd-a frames 232-463, a start inside the crowd) and kitti_late (KITTI 00 frames
-100-199), `run --frames A:B` as a user would. Each row
+100-199), `run --frames A:B` as a user would; on request (`--rows seqa_reversed,bonn_reversed,
+kitti_reversed`) the three recordings played backwards, built under OUT/reversed from symlinks
+(the same criteria; Bonn backwards starts inside the crowd). Each row
 runs twice, `none` and the network; the network row's sim3 is also scored on the frames the none
 run tracked (the "<= 1.1x none" criterion) with `ademono eval`. Every row with depth images
 (seq-a, Bonn, the office and their windows) also runs with sensor depth (`--depth sensor`, the
@@ -37,6 +39,7 @@ import argparse
 import concurrent.futures
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -64,6 +67,12 @@ CRITERIA = {
 WINDOWS = {"seqa_late": ("seqa", "300:600"), "bonn_late": ("bonn", "232:464"),
            "kitti_late": ("kitti", "100:200")}
 
+# The recordings played backwards, built under OUT/reversed from symlinks into ../shared (nothing
+# copied; the TUM and KITTI index files are rewritten, times t' = T - t or 0.1 s apart): other
+# frame orders of the same scenes, the same criteria. Not in the default rows (--rows
+# seqa_reversed,bonn_reversed,kitti_reversed): Bonn backwards starts inside the crowd.
+REVERSED = {"seqa_reversed": "seqa", "bonn_reversed": "bonn", "kitti_reversed": "kitti"}
+
 
 # Rows that also run with sensor depth: the geometric mode's reference on the office, and on the
 # real indoor recordings the run whose error the others share ("shared" below): RGB-D SLAM on the
@@ -71,11 +80,61 @@ WINDOWS = {"seqa_late": ("seqa", "300:600"), "bonn_late": ("bonn", "232:464"),
 # images or in the ground truth (docs/evaluation.md "Errors two runs share").
 WITH_SENSOR = ("none", "network", "sensor")
 MODES = {"office": WITH_SENSOR, "seqa": WITH_SENSOR, "bonn": WITH_SENSOR,
-         "seqa_late": WITH_SENSOR, "bonn_late": WITH_SENSOR}
+         "seqa_late": WITH_SENSOR, "bonn_late": WITH_SENSOR, "seqa_reversed": WITH_SENSOR,
+         "bonn_reversed": WITH_SENSOR}
 
 
 def base(row):
-    return WINDOWS[row][0] if row in WINDOWS else row
+    return WINDOWS[row][0] if row in WINDOWS else REVERSED.get(row, row)
+
+
+def reverse_7scenes(src, dst):
+    os.makedirs(dst, exist_ok=True)
+    os.symlink(os.path.join(src, "camera-intrinsics.txt"), os.path.join(dst, "camera-intrinsics.txt"))
+    n = len([f for f in os.listdir(src) if f.endswith(".color.jpg")])
+    for i in range(n):
+        for ext in ("color.jpg", "depth.png", "pose.txt"):
+            os.symlink(os.path.join(src, "frame-%06d.%s" % (n - 1 - i, ext)),
+                       os.path.join(dst, "frame-%06d.%s" % (i, ext)))
+
+
+def reverse_tum(src, dst):
+    os.makedirs(dst, exist_ok=True)
+    for name in os.listdir(src):
+        if not name.endswith(".txt"):
+            os.symlink(os.path.join(src, name), os.path.join(dst, name))
+    times = []
+    for name in ("rgb.txt", "depth.txt", "groundtruth.txt"):
+        with open(os.path.join(src, name)) as f:
+            times += [float(l.split()[0]) for l in f if l.strip() and not l.startswith("#")]
+    end = max(times) + min(times)  # t' = end - t keeps the times in the recording's range
+    for name in ("rgb.txt", "depth.txt", "groundtruth.txt"):
+        with open(os.path.join(src, name)) as f:
+            lines = f.read().splitlines()
+        head = [l for l in lines if l.startswith("#")]
+        rows = [l.split() for l in lines if l.strip() and not l.startswith("#")]
+        with open(os.path.join(dst, name), "w") as f:
+            f.write("".join(h + "\n" for h in head))
+            for r in reversed(rows):
+                f.write(" ".join(["%.6f" % (end - float(r[0]))] + r[1:]) + "\n")
+
+
+def reverse_kitti(src, dst):
+    """src: the folder holding sequences/00 and poses/00.txt."""
+    seq, out = os.path.join(src, "sequences", "00"), os.path.join(dst, "sequences", "00")
+    os.makedirs(os.path.join(out, "image_2"), exist_ok=True)
+    os.makedirs(os.path.join(dst, "poses"), exist_ok=True)
+    os.symlink(os.path.join(seq, "calib.txt"), os.path.join(out, "calib.txt"))
+    images = sorted(os.listdir(os.path.join(seq, "image_2")))
+    for i, name in enumerate(reversed(images)):
+        os.symlink(os.path.join(seq, "image_2", name),
+                   os.path.join(out, "image_2", "%06d%s" % (i, os.path.splitext(name)[1])))
+    with open(os.path.join(out, "times.txt"), "w") as f:
+        f.write("".join("%e\n" % (0.1 * i) for i in range(len(images))))
+    with open(os.path.join(src, "poses", "00.txt")) as f:
+        poses = [l for l in f.read().splitlines() if l.strip()]
+    with open(os.path.join(dst, "poses", "00.txt"), "w") as f:
+        f.write("".join(l + "\n" for l in reversed(poses[:len(images)])))
 
 
 # What `run` says when geometry alone never found the parallax to start a map (a row of its own,
@@ -103,6 +162,8 @@ class Rows:
         os.makedirs(self.out, exist_ok=True)
 
     def dataset(self, row):
+        if row in REVERSED:
+            return self.reversed(row)
         row = base(row)
         d = os.path.join(self.shared, "data")
         return {
@@ -112,6 +173,24 @@ class Rows:
             "office": "tum:" + os.path.join(self.out, "synth_office"),
             "street": "tum:" + os.path.join(self.out, "synth_street"),
         }[row]
+
+    def reversed(self, row):
+        """The recording of `row` played backwards (built once under OUT/reversed)."""
+        kind = {"seqa": "7scenes", "bonn": "tum", "kitti": "kitti"}[REVERSED[row]]
+        forward = self.dataset(REVERSED[row])[len(kind) + 1:]
+        dst = os.path.join(self.out, "reversed", REVERSED[row])
+        if not os.path.isdir(dst):
+            tmp = dst + ".partial"
+            if os.path.isdir(tmp):
+                shutil.rmtree(tmp)
+            if kind == "7scenes":
+                reverse_7scenes(forward, tmp)
+            elif kind == "tum":
+                reverse_tum(forward, tmp)
+            else:
+                reverse_kitti(os.path.dirname(os.path.dirname(forward)), tmp)
+            os.rename(tmp, dst)
+        return "%s:%s" % (kind, os.path.join(dst, "sequences", "00") if kind == "kitti" else dst)
 
     def model(self, row):
         if base(row) == "kitti":
@@ -141,6 +220,8 @@ class Rows:
         run(cmd, seq + ".log")
 
     def network_depth(self, row):
+        cache_row = row if row in REVERSED else base(row)
+        dataset = self.dataset(row)
         row = base(row)
         if row == "office":
             # FastDepth as measured on seq-a: 0.88x, per-frame log-scale spread 0.16.
@@ -149,10 +230,10 @@ class Rows:
             return "simulated:scale=0.92,jitter=0.1,gt=%s/depth_full" % self.dataset(row)[4:]
         if not self.a.cache:
             return self.model(row)
-        cache = os.path.join(self.out, "cache", row)
+        cache = os.path.join(self.out, "cache", cache_row)
         if not os.path.isdir(os.path.join(cache, "depth")):
             os.makedirs(os.path.dirname(cache), exist_ok=True)
-            cmd = [self.a.bin, "infer", "--dataset", self.dataset(row), "--depth-model",
+            cmd = [self.a.bin, "infer", "--dataset", dataset, "--depth-model",
                    self.model(row), "--out", cache]
             if row == "bonn":
                 cmd += ["--detector", self.detector(row)]
@@ -160,10 +241,11 @@ class Rows:
         return "cache:%s/depth,model=%s" % (cache, self.model(row)[len("model:"):])
 
     def detector_arg(self, row):
+        cache_row = row if row in REVERSED else base(row)
         row = base(row)
         det = self.detector(row)
         if self.a.cache and row == "bonn":
-            return "cache:%s/detections.jsonl" % os.path.join(self.out, "cache", row)
+            return "cache:%s/detections.jsonl" % os.path.join(self.out, "cache", cache_row)
         return det
 
     def config(self, row):
