@@ -110,5 +110,20 @@ TEST_F(CacheDepthTest, CacheOfANetworkIsDescribedAsThatNetwork) {
   EXPECT_FLOAT_EQ(provider->Depth(frame, Camera{}).at<float>(1, 1), 2.5f);
 }
 
+TEST_F(CacheDepthTest, OnlyPngAndTiffContentIsDecoded) {
+  // OpenCV picks the decoder by content: a BMP (or JPEG 2000, PFM, ...) named .png must not
+  // reach a decoder the depth format does not document.
+  const fs::path path = dir_ / "frame-000001.png";
+  ASSERT_TRUE(cv::imwrite((dir_ / "frame.bmp").string(), cv::Mat(4, 6, CV_8UC1, cv::Scalar(3))));
+  fs::rename(dir_ / "frame.bmp", path);
+  try {
+    ReadDepthMap(path);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ": depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)");
+  }
+}
+
 }  // namespace
 }  // namespace ademono

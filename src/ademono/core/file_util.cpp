@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "ademono/core/error.h"
+#include "ademono/core/image_header.h"
 
 namespace fs = std::filesystem;
 
@@ -97,6 +98,15 @@ void SyncDirectory(const fs::path& dir) { SyncPath(dir, O_RDONLY | O_DIRECTORY);
 
 cv::Mat ReadImage(const fs::path& path, int flags) {
   RequireFile(path);
+  // OpenCV's own limit (2^30 pixels) lets a 60-byte file ask for gigabytes.
+  if (const auto header = ReadImageHeader(path);
+      header && (header->width > kMaxImagePixels || header->height > kMaxImagePixels ||
+                 header->width * header->height > kMaxImagePixels)) {
+    ThrowInputError(path, std::string(ImageFormatName(header->format)) + " header declares a " +
+                              std::to_string(header->width) + " x " +
+                              std::to_string(header->height) + " image; the limit is " +
+                              std::to_string(kMaxImagePixels) + " pixels");
+  }
   cv::Mat image;
   try {
     image = cv::imread(path.string(), flags);

@@ -7,6 +7,7 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
+#include "ademono/core/image_header.h"
 
 namespace ademono {
 namespace {
@@ -36,6 +37,12 @@ bool ParseStemTimestamp(const std::string& stem, double* value) {
 }  // namespace
 
 cv::Mat ReadDepthMap(const std::filesystem::path& path) {
+  // Only the two documented formats reach a decoder (imread sniffs the content, not the name).
+  const auto header = ReadImageHeader(path);
+  if (!header || (header->format != ImageFormat::kPng && header->format != ImageFormat::kTiff &&
+                  header->format != ImageFormat::kBigTiff)) {
+    ThrowInputError(path, "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)");
+  }
   const cv::Mat raw = ReadImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
   if (raw.channels() != 1) ThrowInputError(path, "depth map must have one channel");
   cv::Mat depth(raw.size(), CV_32FC1);
