@@ -88,9 +88,7 @@ void SyntheticTruth::Score(const FrameData& frame, const std::vector<Detection>&
                                created,
                            std::vector<PendingPoint>* pending) const {
   const fs::path path = masks_dir_ / (frame.name + ".png");
-  RequireFile(path);
-  const cv::Mat mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (mask.empty()) ThrowInputError(path, "cannot decode the mask image");
+  const cv::Mat mask = ReadImage(path, cv::IMREAD_GRAYSCALE);  // InputError naming the file
   if (!frame.image.empty() && mask.size() != frame.image.size())
     ThrowInputError(path, "mask size differs from the image size");
   // The static person: the person box with the fewest moving pixels, if under 20%.
