@@ -8,6 +8,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <vector>
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
@@ -72,6 +73,17 @@ TEST_F(ImageHeaderTest, ReadsTheSizeOfWhatOpenCvWrites) {
     EXPECT_EQ(header->height, c.image.rows) << c.name;
     EXPECT_EQ(ReadImage(path, cv::IMREAD_UNCHANGED).size(), c.image.size()) << c.name;
   }
+  // Fill bytes and a standalone marker before the frame header do not end the walk.
+  std::string jpeg;
+  {
+    std::vector<uchar> bytes;
+    ASSERT_TRUE(cv::imencode(".jpg", color, bytes));
+    jpeg.assign(bytes.begin(), bytes.end());
+  }
+  const auto padded =
+      Write("e.jpg", jpeg.substr(0, 2) + std::string("\xFF\xFF\xFF\x01", 4) + jpeg.substr(2));
+  ASSERT_TRUE(ReadImageHeader(padded).has_value());
+  EXPECT_EQ(ReadImageHeader(padded)->width, color.cols);
   ASSERT_TRUE(cv::imwrite((dir_ / "d.bmp").string(), color));
   EXPECT_FALSE(ReadImageHeader(dir_ / "d.bmp").has_value());  // other formats: OpenCV decides
 }
@@ -105,7 +117,8 @@ TEST_F(ImageHeaderTest, TruncatedOrEmptyHeadersNameTheFile) {
   // fuzz_depth_image: a classic TIFF entry typed LONG8 has no 8-byte value field to read.
   std::string long8("II*\0\x08\0\0\0\x01\0", 10);
   long8 += std::string("\0\x01\x10\0\x01\0\0\0\x10\0\0\0", 12);
-  EXPECT_THAT(Error(Write("long8.tiff", long8)), testing::HasSubstr("TIFF image size tag has type 16"));
+  EXPECT_THAT(Error(Write("long8.tiff", long8)),
+              testing::HasSubstr("TIFF image size tag has type 16"));
   EXPECT_THAT(Error(Write("junk.png", "not an image")),
               testing::HasSubstr("image does not decode"));
 }

@@ -68,6 +68,10 @@ ImageHeader JpegHeader(ByteReader& file) {
       ++at;
       continue;
     }
+    if (code == 0x01 || (code >= 0xD0 && code <= 0xD8)) {  // TEM, RSTn, SOI: no length field
+      at += 2;
+      continue;
+    }
     const uint64_t length = Unsigned(marker, 2, 2, true);
     if (code >= 0xC0 && code <= 0xCF && code != 0xC4 && code != 0xC8 && code != 0xCC) {
       const std::string sof = file.ReadExactly(at + 4, 5, "JPEG frame header");
