@@ -3,17 +3,16 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "ademono/core/error.h"
-#include "ademono/core/image_header.h"
 
 namespace fs = std::filesystem;
 
@@ -96,11 +95,11 @@ void SyncPath(const fs::path& path, int flags) {
 void SyncFile(const fs::path& path) { SyncPath(path, O_RDONLY); }
 void SyncDirectory(const fs::path& dir) { SyncPath(dir, O_RDONLY | O_DIRECTORY); }
 
-cv::Mat ReadImage(const fs::path& path, int flags) {
-  RequireFile(path);
-  // OpenCV's own limit (2^30 pixels) lets a 60-byte file ask for gigabytes.
-  if (const auto header = ReadImageHeader(path);
-      header && (header->width > kMaxImagePixels || header->height > kMaxImagePixels ||
+namespace {
+// The decode behind both readers, after the header's size check. OpenCV's own limit (2^30
+// pixels) lets a 60-byte file ask for gigabytes.
+cv::Mat DecodeImage(const fs::path& path, int flags, const std::optional<ImageHeader>& header) {
+  if (header && (header->width > kMaxImagePixels || header->height > kMaxImagePixels ||
                  header->width * header->height > kMaxImagePixels)) {
     ThrowInputError(path, std::string(ImageFormatName(header->format)) + " header declares a " +
                               std::to_string(header->width) + " x " +
@@ -115,6 +114,19 @@ cv::Mat ReadImage(const fs::path& path, int flags) {
   }
   if (image.empty()) ThrowInputError(path, "image does not decode");
   return image;
+}
+}  // namespace
+
+cv::Mat ReadImage(const fs::path& path, int flags) {
+  return DecodeImage(path, flags, ReadImageHeader(path));
+}
+
+cv::Mat ReadImage(const fs::path& path, int flags, std::initializer_list<ImageFormat> formats,
+                  const std::string& otherwise) {
+  const std::optional<ImageHeader> header = ReadImageHeader(path);
+  if (!header || std::find(formats.begin(), formats.end(), header->format) == formats.end())
+    ThrowInputError(path, otherwise);
+  return DecodeImage(path, flags, header);
 }
 
 std::vector<std::string_view> SplitFields(std::string_view line, bool commas) {

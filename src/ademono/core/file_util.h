@@ -4,12 +4,14 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
+#include <opencv2/core.hpp>
 #include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include <opencv2/core.hpp>
+#include "ademono/core/image_header.h"
 
 namespace ademono {
 
@@ -28,9 +30,13 @@ void WriteImageAtomic(const std::filesystem::path& path, const cv::Mat& image);
 void SyncFile(const std::filesystem::path& path);
 void SyncDirectory(const std::filesystem::path& dir);
 
-// Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing or does not
-// decode.
+// Reads an image (cv::IMREAD_* flags); InputError naming the file if it is missing, declares
+// more than kMaxImagePixels (image_header.h) or does not decode.
 cv::Mat ReadImage(const std::filesystem::path& path, int flags);
+// The same for content of `formats` only (OpenCV picks its decoder by content, not by name):
+// InputError "path: <otherwise>" for anything else.
+cv::Mat ReadImage(const std::filesystem::path& path, int flags,
+                  std::initializer_list<ImageFormat> formats, const std::string& otherwise);
 
 // Splits on whitespace (and commas when `commas` is true), dropping empty fields.
 std::vector<std::string_view> SplitFields(std::string_view line, bool commas = false);

@@ -7,7 +7,6 @@
 
 #include "ademono/core/error.h"
 #include "ademono/core/file_util.h"
-#include "ademono/core/image_header.h"
 
 namespace ademono {
 namespace {
@@ -37,13 +36,11 @@ bool ParseStemTimestamp(const std::string& stem, double* value) {
 }  // namespace
 
 cv::Mat ReadDepthMap(const std::filesystem::path& path) {
-  // Only the two documented formats reach a decoder (imread sniffs the content, not the name).
-  const auto header = ReadImageHeader(path);
-  if (!header || (header->format != ImageFormat::kPng && header->format != ImageFormat::kTiff &&
-                  header->format != ImageFormat::kBigTiff)) {
-    ThrowInputError(path, "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)");
-  }
-  const cv::Mat raw = ReadImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+  const char* format = "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)";
+  // Only the two documented formats reach a decoder.
+  const cv::Mat raw =
+      ReadImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR,
+                {ImageFormat::kPng, ImageFormat::kTiff, ImageFormat::kBigTiff}, format);
   if (raw.channels() != 1) ThrowInputError(path, "depth map must have one channel");
   cv::Mat depth(raw.size(), CV_32FC1);
   if (raw.depth() == CV_16U) {
@@ -62,7 +59,7 @@ cv::Mat ReadDepthMap(const std::filesystem::path& path) {
         out[x] = (std::isfinite(in[x]) && in[x] > 0.f) ? in[x] : 0.f;
     }
   } else {
-    ThrowInputError(path, "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)");
+    ThrowInputError(path, format);
   }
   return depth;
 }
