@@ -7,7 +7,8 @@
 #     the parser and feature-filter tests: test_core, test_io and test_filter run under ASan + UBSan;
 #   - the threaded mapping tests under ThreadSanitizer (build/tsan: the modules that run on
 #     several threads instrumented, the others as in build/release, from ccache);
-#   - every fuzz target for ADEMONO_CI_FUZZ_SECONDS (default 5) seconds.
+#   - every fuzz target for ADEMONO_CI_FUZZ_SECONDS (default 5) seconds, with a fixed seed
+#     (ADEMONO_FUZZ_SEED, default 1): a clean clone tries the same inputs every time.
 # With ADEMONO_RELIABILITY=1, then the longer checks, beyond CI's 20 minutes on 2 cores:
 #   - the whole suite again under ASan + UBSan (GCC, build/asan);
 #   - the threaded mapping tests under TSan with every module instrumented (build/tsan-all);
@@ -33,7 +34,7 @@ echo "== threaded mapping under ThreadSanitizer"
 TSAN_OPTIONS="suppressions=$here/tools/tsan.supp" "$here/build/tsan/test_threaded_mapping" --gtest_brief=1
 
 echo "== fuzzing, ${ADEMONO_CI_FUZZ_SECONDS:-5} s per target"
-"$here/tools/fuzz.sh" "${ADEMONO_CI_FUZZ_SECONDS:-5}"
+ADEMONO_FUZZ_SEED="${ADEMONO_FUZZ_SEED:-1}" "$here/tools/fuzz.sh" "${ADEMONO_CI_FUZZ_SECONDS:-5}"
 
 [ "${ADEMONO_RELIABILITY:-0}" = 1 ] || exit 0
 

@@ -4,11 +4,17 @@
 # The corpus grows in build/fuzz/corpus/<target> across runs (seeds: fuzz/make_seeds.py from the
 # test fixtures' formats and configs/); a crashing input lands in build/fuzz/artifacts/<target>/.
 # Exit status 1 when any target found a crash, leak, UB or timeout.
+# ADEMONO_FUZZ_SEED=N fixes libFuzzer's random seed (-seed=N), so a run on the same corpus tries
+# the same inputs in the same order (CI: scripts/test.sh sets 1); unset or 0, libFuzzer draws one.
 # Usage: tools/fuzz.sh [SECONDS] [TARGET...]     e.g. tools/fuzz.sh 600 trajectory_tum camera_yaml
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-60}"
 [ $# -gt 0 ] && shift
+seed="${ADEMONO_FUZZ_SEED:-0}"
+case "$seed" in
+  ''|*[!0-9]*) echo "tools/fuzz.sh: ADEMONO_FUZZ_SEED must be a non-negative integer, got '$seed'" >&2; exit 2 ;;
+esac
 build="$here/build/fuzz"
 "$here/scripts/setup.sh" --fuzz >/dev/null
 
@@ -26,6 +32,7 @@ export LSAN_OPTIONS="suppressions=$here/tools/lsan_onnxruntime.supp"
 export UBSAN_OPTIONS="print_stacktrace=1"
 
 failed=0
+if [ "$seed" = 0 ]; then echo "seed: libFuzzer's own (set ADEMONO_FUZZ_SEED to fix it)"; else echo "seed: $seed"; fi
 printf '%-22s %8s %12s  %s\n' target seconds inputs result
 for t in "${targets[@]}"; do
   corpus="$build/corpus/$t" artifacts="$build/artifacts/$t/" log="$build/logs/$t.log"
@@ -34,7 +41,7 @@ for t in "${targets[@]}"; do
   start=$(date +%s)
   status=ok
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb: a 2 GB input is a bug too.
-  if ! "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if ! "$build/fuzz/fuzz_$t" -seed="$seed" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -max_len=4096 -print_final_stats=1 -artifact_prefix="$artifacts" \
       "$corpus" "$seeds" >"$log" 2>&1; then
     status="FAILED (see $log, input in $artifacts)"
