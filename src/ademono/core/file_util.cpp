@@ -96,16 +96,9 @@ void SyncFile(const fs::path& path) { SyncPath(path, O_RDONLY); }
 void SyncDirectory(const fs::path& dir) { SyncPath(dir, O_RDONLY | O_DIRECTORY); }
 
 namespace {
-// The decode behind both readers, after the header's size check. OpenCV's own limit (2^30
-// pixels) lets a 60-byte file ask for gigabytes.
-cv::Mat DecodeImage(const fs::path& path, int flags, const std::optional<ImageHeader>& header) {
-  if (header && (header->width > kMaxImagePixels || header->height > kMaxImagePixels ||
-                 header->width * header->height > kMaxImagePixels)) {
-    ThrowInputError(path, std::string(ImageFormatName(header->format)) + " header declares a " +
-                              std::to_string(header->width) + " x " +
-                              std::to_string(header->height) + " image; the limit is " +
-                              std::to_string(kMaxImagePixels) + " pixels");
-  }
+// The decode behind both readers, once ReadImageHeader has checked the declared size: OpenCV's
+// own limit (2^30 pixels) lets a 60-byte file ask for gigabytes.
+cv::Mat DecodeImage(const fs::path& path, int flags) {
   cv::Mat image;
   try {
     image = cv::imread(path.string(), flags);
@@ -118,7 +111,8 @@ cv::Mat DecodeImage(const fs::path& path, int flags, const std::optional<ImageHe
 }  // namespace
 
 cv::Mat ReadImage(const fs::path& path, int flags) {
-  return DecodeImage(path, flags, ReadImageHeader(path));
+  ReadImageHeader(path);  // throws on a declared size past kMaxImagePixels
+  return DecodeImage(path, flags);
 }
 
 cv::Mat ReadImage(const fs::path& path, int flags, std::initializer_list<ImageFormat> formats,
@@ -126,7 +120,7 @@ cv::Mat ReadImage(const fs::path& path, int flags, std::initializer_list<ImageFo
   const std::optional<ImageHeader> header = ReadImageHeader(path);
   if (!header || std::find(formats.begin(), formats.end(), header->format) == formats.end())
     ThrowInputError(path, otherwise);
-  return DecodeImage(path, flags, header);
+  return DecodeImage(path, flags);
 }
 
 std::vector<std::string_view> SplitFields(std::string_view line, bool commas) {

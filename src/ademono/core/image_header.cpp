@@ -148,10 +148,17 @@ std::optional<ImageHeader> ReadImageHeader(const fs::path& path) {
   } else {
     return std::nullopt;
   }
-  if (header.width <= 0 || header.height <= 0) {
+  const bool empty = header.width <= 0 || header.height <= 0;
+  // Both sides at most 2^26 before the product is taken: no overflow.
+  const bool huge = !empty && (header.width > kMaxImagePixels || header.height > kMaxImagePixels ||
+                               header.width * header.height > kMaxImagePixels);
+  if (empty || huge) {
     ThrowInputError(path, std::string(ImageFormatName(header.format)) + " header declares a " +
                               std::to_string(header.width) + " x " + std::to_string(header.height) +
-                              " image");
+                              " image" +
+                              (huge ? "; the limit is " + std::to_string(kMaxImagePixels) +
+                                          " pixels"
+                                    : ""));
   }
   return header;
 }

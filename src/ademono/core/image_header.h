@@ -24,7 +24,8 @@ inline constexpr int64_t kMaxImagePixels = int64_t{1} << 26;
 const char* ImageFormatName(ImageFormat format);
 
 // The header of a PNG, JPEG or (Big)TIFF file; std::nullopt for any other signature. InputError
-// naming the file when a recognised header is truncated or declares no size.
+// naming the file when a recognised header is truncated, declares no size or declares more than
+// kMaxImagePixels.
 std::optional<ImageHeader> ReadImageHeader(const std::filesystem::path& path);
 
 }  // namespace ademono

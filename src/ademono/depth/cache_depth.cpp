@@ -36,11 +36,11 @@ bool ParseStemTimestamp(const std::string& stem, double* value) {
 }  // namespace
 
 cv::Mat ReadDepthMap(const std::filesystem::path& path) {
-  const char* format = "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)";
+  const char* expected = "depth map must be 16-bit PNG (mm) or 32-bit float TIFF (m)";
   // Only the two documented formats reach a decoder.
   const cv::Mat raw =
       ReadImage(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR,
-                {ImageFormat::kPng, ImageFormat::kTiff, ImageFormat::kBigTiff}, format);
+                {ImageFormat::kPng, ImageFormat::kTiff, ImageFormat::kBigTiff}, expected);
   if (raw.channels() != 1) ThrowInputError(path, "depth map must have one channel");
   cv::Mat depth(raw.size(), CV_32FC1);
   if (raw.depth() == CV_16U) {
@@ -59,7 +59,7 @@ cv::Mat ReadDepthMap(const std::filesystem::path& path) {
         out[x] = (std::isfinite(in[x]) && in[x] > 0.f) ? in[x] : 0.f;
     }
   } else {
-    ThrowInputError(path, format);
+    ThrowInputError(path, expected);
   }
   return depth;
 }
