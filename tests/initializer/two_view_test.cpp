@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace ademono {
@@ -136,6 +137,55 @@ TEST(TwoViewTest, OutliersAreRejectedAndTheMotionStillRecovered) {
   int wrong_triangulated = 0;
   for (size_t i = 0; i < n / 5; ++i) wrong_triangulated += r.triangulated[i * 5];
   EXPECT_LT(wrong_triangulated, static_cast<int>(n / 50) + 2);
+}
+
+// ORB-SLAM's scores, every match counted (the initialiser stops scoring a hypothesis once it
+// cannot win; what it reports must still be the chosen models' full scores).
+double FullHomographyScore(const Eigen::Matrix3d& H21, const Views& v) {
+  const Eigen::Matrix3d H12 = H21.inverse();
+  double score = 0;
+  for (size_t i = 0; i < v.pixels1.size(); ++i) {
+    const Eigen::Vector2d to1 = (H12 * v.pixels2[i].homogeneous()).hnormalized();
+    const Eigen::Vector2d to2 = (H21 * v.pixels1[i].homogeneous()).hnormalized();
+    const double chi1 = (v.pixels1[i] - to1).squaredNorm();
+    const double chi2 = (v.pixels2[i] - to2).squaredNorm();
+    if (chi1 <= 5.991 && chi2 <= 5.991) score += (5.991 - chi1) + (5.991 - chi2);
+  }
+  return score;
+}
+
+double FullFundamentalScore(const Eigen::Matrix3d& F21, const Views& v) {
+  double score = 0;
+  for (size_t i = 0; i < v.pixels1.size(); ++i) {
+    const Eigen::Vector3d x1 = v.pixels1[i].homogeneous(), x2 = v.pixels2[i].homogeneous();
+    const Eigen::Vector3d l2 = F21 * x1, l1 = F21.transpose() * x2;
+    const double chi2 = std::pow(l2.dot(x2), 2) / l2.head<2>().squaredNorm();
+    const double chi1 = std::pow(l1.dot(x1), 2) / l1.head<2>().squaredNorm();
+    if (chi1 <= 3.841 && chi2 <= 3.841) score += (5.991 - chi1) + (5.991 - chi2);
+  }
+  return score;
+}
+
+TEST(TwoViewTest, ReportedScoresAreTheChosenModelsFullScores) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(-2.5, 2.5), depth(3.0, 8.0), px(0, 480);
+  std::normal_distribution<double> noise(0.0, 0.7);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 400; ++i) {
+    const double z = depth(rng);
+    points.emplace_back(xy(rng) * z / 5, xy(rng) * z / 6.5, z);
+  }
+  Views v = Project(points, Motion({0.01, 0.04, -0.02}, {-0.3, 0.02, 0.05}));
+  // Keypoint noise (scores below their maximum) and 30 % wrong matches (most minimal sets lose).
+  for (auto& p : v.pixels2) p += Eigen::Vector2d(noise(rng), noise(rng));
+  for (size_t i = 0; i < v.pixels2.size(); i += 3) v.pixels2[i] = {px(rng) * 4 / 3, px(rng)};
+  const TwoViewResult r = InitializeTwoView(TestK(), v.pixels1, v.pixels2);
+  ASSERT_GT(r.score_homography, 0);
+  ASSERT_GT(r.score_fundamental, 0);
+  EXPECT_NEAR(r.score_homography, FullHomographyScore(r.H21, v), 1e-6 * r.score_homography);
+  EXPECT_NEAR(r.score_fundamental, FullFundamentalScore(r.F21, v), 1e-6 * r.score_fundamental);
+  EXPECT_EQ(r.model, TwoViewModel::kFundamental);
+  EXPECT_TRUE(r.valid) << r.failure;
 }
 
 TEST(TwoViewTest, PureRotationAndTooLittleParallaxAreRefused) {

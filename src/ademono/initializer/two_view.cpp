@@ -128,15 +128,32 @@ Eigen::Vector2d Transfer(const Eigen::Matrix3d& H, const Eigen::Vector2d& p) {
   return x.hnormalized();
 }
 
+// A match adds at most this to a score (both of its terms at chi2 = 0).
+constexpr double kMaxMatchScore = 2 * kChi2TwoDof;
+
+// Whether a hypothesis whose first `scored` of `n` matches sum to `score` can no longer beat
+// `to_beat` (RANSAC keeps a model only when it scores strictly more): even if every remaining
+// match added kMaxMatchScore. The margin covers the sums' rounding, so a hypothesis is dropped
+// only when it provably loses: the chosen model is the same as with every match scored.
+bool CannotBeat(double score, size_t scored, size_t n, double to_beat) {
+  const double bound = score + kMaxMatchScore * static_cast<double>(n - scored);
+  return bound < to_beat - 1e-9 * std::abs(to_beat);
+}
+
+// Every this many matches the bound above is checked.
+constexpr size_t kBoundStride = 16;
+
 // ORB-SLAM's score: the sum over matches of (threshold - chi2) in both directions, for the
-// matches within the threshold in both; `inliers` marks those.
+// matches within the threshold in both; `inliers` marks those. Returns -1 (and partial inliers)
+// as soon as the score cannot exceed `to_beat`.
 double ScoreHomography(const Eigen::Matrix3d& H21, const std::vector<Eigen::Vector2d>& p1,
                        const std::vector<Eigen::Vector2d>& p2, double inv_sigma2,
-                       std::vector<uint8_t>* inliers) {
+                       std::vector<uint8_t>* inliers, double to_beat) {
   const Eigen::Matrix3d H12 = H21.inverse();
   double score = 0;
   inliers->assign(p1.size(), 0);
   for (size_t i = 0; i < p1.size(); ++i) {
+    if (i % kBoundStride == 0 && CannotBeat(score, i, p1.size(), to_beat)) return -1;
     const double chi1 = (p1[i] - Transfer(H12, p2[i])).squaredNorm() * inv_sigma2;
     const double chi2 = (p2[i] - Transfer(H21, p1[i])).squaredNorm() * inv_sigma2;
     if (!(chi1 <= kChi2TwoDof) || !(chi2 <= kChi2TwoDof)) continue;
@@ -150,10 +167,11 @@ double ScoreHomography(const Eigen::Matrix3d& H21, const std::vector<Eigen::Vect
 // against the 2-dof threshold, as the homography does, so that the two scores compare.
 double ScoreFundamental(const Eigen::Matrix3d& F21, const std::vector<Eigen::Vector2d>& p1,
                         const std::vector<Eigen::Vector2d>& p2, double inv_sigma2,
-                        std::vector<uint8_t>* inliers) {
+                        std::vector<uint8_t>* inliers, double to_beat) {
   double score = 0;
   inliers->assign(p1.size(), 0);
   for (size_t i = 0; i < p1.size(); ++i) {
+    if (i % kBoundStride == 0 && CannotBeat(score, i, p1.size(), to_beat)) return -1;
     const Eigen::Vector3d x1 = p1[i].homogeneous(), x2 = p2[i].homogeneous();
     const Eigen::Vector3d l2 = F21 * x1;             // in image 2
     const Eigen::Vector3d l1 = F21.transpose() * x2;  // in image 1
@@ -348,7 +366,7 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
       }
       const std::optional<Eigen::Matrix3d> m = fit(s1, s2);
       if (!m) continue;
-      const double s = score(*m, &current);
+      const double s = score(*m, &current, best);
       if (s > best) {
         best = s;
         *model = *m;
@@ -366,8 +384,8 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
           if (!H.allFinite() || !(std::abs(H.determinant()) > 1e-15)) return std::nullopt;
           return H;
         },
-        [&](const Eigen::Matrix3d& H, std::vector<uint8_t>* current) {
-          return ScoreHomography(H, pixels1, pixels2, inv_sigma2, current);
+        [&](const Eigen::Matrix3d& H, std::vector<uint8_t>* current, double to_beat) {
+          return ScoreHomography(H, pixels1, pixels2, inv_sigma2, current, to_beat);
         },
         &result.H21, &inliers_h);
   };
@@ -378,8 +396,8 @@ TwoViewResult InitializeTwoView(const Eigen::Matrix3d& K,
           if (!F.allFinite()) return std::nullopt;
           return F;
         },
-        [&](const Eigen::Matrix3d& F, std::vector<uint8_t>* current) {
-          return ScoreFundamental(F, pixels1, pixels2, inv_sigma2, current);
+        [&](const Eigen::Matrix3d& F, std::vector<uint8_t>* current, double to_beat) {
+          return ScoreFundamental(F, pixels1, pixels2, inv_sigma2, current, to_beat);
         },
         &result.F21, &inliers_f);
   };
