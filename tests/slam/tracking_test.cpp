@@ -125,5 +125,66 @@ TEST(TrackingTest, LocalBaFixedKeyframesAreCapped) {
   EXPECT_LT(std::sqrt(sum2 / 80.0), 0.02);
 }
 
+
+// The first map from a frame with walkers in it: the points inside their boxes start at the box
+// prior (kept out of the pose until the geometric test finds them static), the rest usable at
+// once; when the boxes fill the view, their points are all there is to track on and start usable.
+struct FirstMapPoints {
+  int in_boxes = 0, in_boxes_at_box_prior = 0, outside = 0, outside_usable = 0;
+};
+
+FirstMapPoints FirstMap(const SyntheticOffice& sequence, size_t frame_index,
+                        const std::vector<Detection>& detections, const SystemOptions& options) {
+  System system(sequence.GetCamera(), options);
+  const FrameData frame = sequence.Load(frame_index);
+  EXPECT_TRUE(system.TrackFrame(frame, frame.depth, detections).tracked);
+  system.Shutdown();
+  const MapFileData map = system.MapRecords();
+  EXPECT_EQ(map.keyframes.size(), 1u);
+  FirstMapPoints out;
+  for (const MapPointRecord& p : map.points) {
+    EXPECT_EQ(p.observations.size(), 1u);
+    const MapKeyPointRecord& kp = map.keyframes.front().keypoints.at(p.observations[0].second);
+    const bool inside = std::any_of(detections.begin(), detections.end(), [&](const Detection& d) {
+      return d.box.contains(cv::Point2f(kp.x, kp.y));
+    });
+    const bool usable = p.static_probability >= options.tracking.static_params.threshold;
+    if (inside) {
+      ++out.in_boxes;
+      out.in_boxes_at_box_prior += p.static_probability == options.tracking.static_params.box_prior;
+    } else {
+      ++out.outside;
+      out.outside_usable += usable;
+    }
+  }
+  return out;
+}
+
+TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
+  const SyntheticOffice sequence;
+  const SystemOptions options;
+  ASSERT_TRUE(options.tracking.static_test);
+  size_t first = 0;
+  while (first < sequence.Size() && sequence.Detections(first).empty()) ++first;
+  ASSERT_LT(first, sequence.Size()) << "no frame with a walker in view";
+  const FirstMapPoints walkers = FirstMap(sequence, first, sequence.Detections(first), options);
+  EXPECT_GT(walkers.in_boxes, 10);
+  EXPECT_EQ(walkers.in_boxes_at_box_prior, walkers.in_boxes);
+  EXPECT_GT(walkers.outside, options.tracking.min_inliers_after_reloc);
+  // Points just outside a box lie inside its grown margin and start at the box prior too.
+  EXPECT_GT(walkers.outside_usable, walkers.outside / 2);
+
+  // One box over the whole view: nothing outside it could pose the next frame.
+  Detection everything;
+  everything.class_id = 0;
+  everything.class_name = "person";
+  everything.score = 0.9f;
+  everything.box = cv::Rect2f(0, 0, static_cast<float>(sequence.GetCamera().width),
+                              static_cast<float>(sequence.GetCamera().height));
+  const FirstMapPoints filled = FirstMap(sequence, first, {everything}, options);
+  EXPECT_GT(filled.in_boxes, options.tracking.min_init_points);
+  EXPECT_EQ(filled.in_boxes_at_box_prior, 0);
+}
+
 }  // namespace
 }  // namespace ademono
