@@ -162,7 +162,8 @@ FirstMapPoints FirstMap(const SyntheticOffice& sequence, size_t frame_index,
 
 TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
   const SyntheticOffice sequence;
-  const SystemOptions options;
+  SystemOptions options;
+  options.tracking.first_map_box_prior = true;  // as the indoor RGB-D configs set it
   ASSERT_TRUE(options.tracking.static_test);
   size_t first = 0;
   while (first < sequence.Size() && sequence.Detections(first).empty()) ++first;
@@ -184,6 +185,14 @@ TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
   const FirstMapPoints filled = FirstMap(sequence, first, {everything}, options);
   EXPECT_GT(filled.in_boxes, options.tracking.min_init_points);
   EXPECT_EQ(filled.in_boxes_at_box_prior, 0);
+
+  // Off (the default, and outdoors, where a first frame's cars are mostly parked): every point
+  // starts usable.
+  options.tracking.first_map_box_prior = false;
+  const FirstMapPoints trusted = FirstMap(sequence, first, sequence.Detections(first), options);
+  EXPECT_EQ(trusted.in_boxes, walkers.in_boxes);
+  EXPECT_EQ(trusted.in_boxes_at_box_prior, 0);
+  EXPECT_EQ(trusted.outside_usable, trusted.outside);
 }
 
 }  // namespace

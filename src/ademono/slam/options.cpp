@@ -95,6 +95,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("dynamic_cull_hits", &T::dynamic_cull_hits, Range::Above(0))
           .Add("static_test", &T::static_test)
           .AddFlat(&T::static_params, StaticTestParams::Table())
+          .Add("first_map_box_prior", &T::first_map_box_prior)
           .Add("weak_pose_max_frames", &T::weak_pose_max_frames, Range::AtLeast(0))
           .Add("weak_pose_min_inliers", &T::weak_pose_min_inliers, Range::AtLeast(3))
           .Add("weak_pose_sets_velocity", &T::weak_pose_sets_velocity)

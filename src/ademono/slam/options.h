@@ -148,6 +148,12 @@ struct TrackingOptions {
   // (slam/static_probability.h, docs/slam.md).
   bool static_test = true;
   StaticTestParams static_params;  // keys static_prior, static_threshold, ...
+  // The first map's (and a restart's) points inside a detector's dynamic box start at the box
+  // prior, as a keyframe's new points do, when at least min_inliers_after_reloc points with depth
+  // lie outside the boxes. A domain's prior: indoors a person in the first frame usually walks,
+  // outdoors a car in it is usually parked and much of the near structure. false: every first-map
+  // point starts usable (nothing to judge it against yet).
+  bool first_map_box_prior = false;
   // Degrade instead of dropping a frame: when tracking fails while the last frame was tracked,
   // the pose is still reported (weak) for up to weak_pose_max_frames frames in a row: optimised
   // on its few static points when it keeps at least weak_pose_min_inliers, else the

@@ -406,14 +406,16 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   const Rigid3d world_from_cam = cam_from_world.inverse();
   const FrameFeatures& f = frame.F();
   auto boxed = [&](size_t i) { return i < in_dynamic_box_.size() && in_dynamic_box_[i]; };
-  // The first map has nothing to be judged against: usable from the start. Points inside a
-  // detector's dynamic box start at the box prior, as a keyframe's new points do (a walker in
-  // the first frame would otherwise pose the next frames until the test caught up), when the
-  // rest can pose a frame on their own: at least min_inliers_after_reloc, what the tracker asks
-  // of a pose found with no prior. A view the boxes fill needs their points to track at all.
+  // The first map has nothing to be judged against: usable from the start. With
+  // tracking.first_map_box_prior, points inside a detector's dynamic box start at the box prior,
+  // as a keyframe's new points do (a walker in the first frame would otherwise pose the next
+  // frames until the test caught up), when the rest can pose a frame on their own: at least
+  // min_inliers_after_reloc, what the tracker asks of a pose found with no prior. A view the
+  // boxes fill needs their points to track at all.
   int unboxed = 0;
   for (size_t i = 0; i < f.Size(); ++i) unboxed += f.depth[i] > 0 && !boxed(i) ? 1 : 0;
-  const bool distrust_boxes = unboxed >= options_.tracking.min_inliers_after_reloc;
+  const bool distrust_boxes = options_.tracking.first_map_box_prior &&
+                              unboxed >= options_.tracking.min_inliers_after_reloc;
   spdlog::debug("first map: {} points with depth, {} outside dynamic boxes{}",
                 CountDepthPoints(frame), unboxed, distrust_boxes ? "" : " (boxes trusted)");
   for (size_t i = 0; i < f.Size(); ++i) {
