@@ -400,7 +400,8 @@ void Tracking::CreatePointFromDepth(Frame& frame, KeyFrame& keyframe,
 }
 
 bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
-  if (CountDepthPoints(frame) < options_.tracking.min_init_points) return false;
+  const int with_depth = CountDepthPoints(frame);
+  if (with_depth < options_.tracking.min_init_points) return false;
   frame.cam_from_world = cam_from_world;
   std::shared_ptr<KeyFrame> kf = map_.CreateKeyFrame(frame);
   const Rigid3d world_from_cam = cam_from_world.inverse();
@@ -416,8 +417,8 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   for (size_t i = 0; i < f.Size(); ++i) unboxed += f.depth[i] > 0 && !boxed(i) ? 1 : 0;
   const bool distrust_boxes = options_.tracking.first_map_box_prior &&
                               unboxed >= options_.tracking.min_inliers_after_reloc;
-  spdlog::debug("first map: {} points with depth, {} outside dynamic boxes{}",
-                CountDepthPoints(frame), unboxed, distrust_boxes ? "" : " (boxes trusted)");
+  spdlog::debug("first map: {} points with depth, {} outside dynamic boxes{}", with_depth, unboxed,
+                distrust_boxes ? "" : " (boxes trusted)");
   for (size_t i = 0; i < f.Size(); ++i) {
     if (f.depth[i] <= 0) continue;
     CreatePointFromDepth(frame, *kf, world_from_cam, i,
