@@ -92,6 +92,7 @@ const OptionsTable<TrackingOptions>& TrackingOptions::Table() {
           .Add("new_keyframe_min_points", &T::new_keyframe_min_points, Range::AtLeast(0))
           .Add("relocalisation_keyframes", &T::relocalisation_keyframes, Range::Above(0))
           .Add("reinit_after_lost_frames", &T::reinit_after_lost_frames, Range::AtLeast(0))
+          .Add("reseed_after_odometry_frames", &T::reseed_after_odometry_frames, Range::AtLeast(0))
           .Add("dynamic_cull_hits", &T::dynamic_cull_hits, Range::Above(0))
           .Add("static_test", &T::static_test)
           .AddFlat(&T::static_params, StaticTestParams::Table())

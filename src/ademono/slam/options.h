@@ -142,6 +142,11 @@ struct TrackingOptions {
   int new_keyframe_min_points = 100;  // map points created from a new keyframe's depth at least
   int relocalisation_keyframes = 20;  // most recent keyframes tried when lost
   int reinit_after_lost_frames = 10;  // lost this long: restart tracking from the last pose
+  // This many frames in a row posed on the last frame's depths (PoseQuality::kDepthOdometry: the
+  // local map has nothing left where the camera looks), the last by at least
+  // min_inliers_after_reloc points, re-seed the map there from the frame's depths, as a restart
+  // after reinit_after_lost_frames does, without first losing frames. 0: off.
+  int reseed_after_odometry_frames = 0;
   int dynamic_cull_hits = 3;          // map points seen this often inside dynamic boxes are culled
   // Geometric test for movers without a box: each map point's static probability, judged by
   // every frame that matches it; points below static_threshold are not used for the pose

@@ -283,6 +283,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       state_ = TrackingState::kOk;
       lost_streak_ = 0;
       weak_streak_ = weak ? weak_streak_ + 1 : 0;
+      odometry_streak_ = out.quality == PoseQuality::kDepthOdometry ? odometry_streak_ + 1 : 0;
       if (out.quality != PoseQuality::kMotionModel) CorrectDepthScale(frame, true);
       if (!weak) {
         recent_good_.emplace_back(frame.id, *frame.cam_from_world);
@@ -313,6 +314,19 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
           out.new_keyframe->ground = std::move(ground);
         }
       }
+      if (options_.tracking.reseed_after_odometry_frames > 0 &&
+          odometry_streak_ >= options_.tracking.reseed_after_odometry_frames &&
+          matches_inliers_ >= options_.tracking.min_inliers_after_reloc &&
+          CountDepthPoints(frame) >= options_.tracking.min_init_points) {
+        const Rigid3d cam_from_world = *frame.cam_from_world;
+        frame.map_points.assign(frame.F().Size(), nullptr);
+        frame.outlier.assign(frame.F().Size(), false);
+        if (Initialise(frame, cam_from_world)) {
+          out.reinitialised = true;
+          out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
+          weak_streak_ = odometry_streak_ = 0;
+        }
+      }
       // Outliers do not carry over to the next frame's motion-model search.
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
         if (frame.map_points[i] && frame.outlier[i]) frame.map_points[i].reset();
@@ -324,7 +338,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // The frames before a loss are not blended with whatever keyframe comes after it (a new
       // start, or a relocalisation elsewhere): they keep their reference keyframe.
       newest_keyframe_ = nullptr;
-      weak_streak_ = 0;
+      weak_streak_ = odometry_streak_ = 0;
       ++lost_streak_;
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).

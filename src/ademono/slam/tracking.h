@@ -238,6 +238,7 @@ class Tracking {
   int matches_inliers_ = 0;
   int lost_streak_ = 0;
   int weak_streak_ = 0;        // consecutive weak poses (PoseQuality)
+  int odometry_streak_ = 0;    // consecutive poses on the last frame's depths (kDepthOdometry)
   int judged_dynamic_ = 0;     // JudgeStaticness of the current frame
   std::vector<uint8_t> in_dynamic_box_;  // the current frame's (Track's argument)
   int geometric_culled_ = 0;
