@@ -95,8 +95,10 @@ FilteredFrame FrontEnd::Filter(const ExtractedFrame& extracted,
       out.moving_detections.push_back(d);
   }
   // Kept keypoints inside a dynamic-class box (grown as the filter grows them): the geometric
-  // test starts the map points made from them at the lower box prior.
-  if (options_.filter.enable_dynamic_removal && options_.tracking.static_test) {
+  // test starts the map points made from them at the lower box prior; without the test, a first
+  // map leaves them out (tracking.first_map_box_prior).
+  if (options_.filter.enable_dynamic_removal &&
+      (options_.tracking.static_test || options_.tracking.first_map_box_prior)) {
     const std::vector<GrownBox> boxes = GrowDynamicBoxes(
         detections, cv::Size(camera_.width, camera_.height), options_.filter.dynamic);
     if (!boxes.empty()) {

@@ -155,9 +155,10 @@ struct TrackingOptions {
   StaticTestParams static_params;  // keys static_prior, static_threshold, ...
   // The first map's (and a restart's) points inside a detector's dynamic box start at the box
   // prior, as a keyframe's new points do, when at least min_inliers_after_reloc points with depth
-  // lie outside the boxes. A domain's prior: indoors a person in the first frame usually walks,
-  // outdoors a car in it is usually parked and much of the near structure. false: every first-map
-  // point starts usable (nothing to judge it against yet).
+  // lie outside the boxes; without the static test (the network families) they are left out,
+  // since nothing would judge them later. A domain's prior: indoors a person in the first frame
+  // usually walks, outdoors a car in it is usually parked and much of the near structure. false:
+  // every first-map point starts usable (nothing to judge it against yet).
   bool first_map_box_prior = false;
   // Degrade instead of dropping a frame: when tracking fails while the last frame was tracked,
   // the pose is still reported (weak) for up to weak_pose_max_frames frames in a row: optimised

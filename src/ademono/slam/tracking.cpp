@@ -435,6 +435,8 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
                 distrust_boxes ? "" : " (boxes trusted)");
   for (size_t i = 0; i < f.Size(); ++i) {
     if (f.depth[i] <= 0) continue;
+    // Without the geometric test nothing would ever judge such a point: it is left out.
+    if (distrust_boxes && boxed(i) && !options_.tracking.static_test) continue;
     CreatePointFromDepth(frame, *kf, world_from_cam, i,
                          distrust_boxes && boxed(i)
                              ? options_.tracking.static_params.box_prior
