@@ -160,6 +160,16 @@ FirstMapPoints FirstMap(const SyntheticOffice& sequence, size_t frame_index,
   return out;
 }
 
+// A person's box over the whole view.
+Detection ViewFillingPerson(const Camera& camera) {
+  Detection d;
+  d.class_id = 0;
+  d.class_name = "person";
+  d.score = 0.9f;
+  d.box = cv::Rect2f(0, 0, static_cast<float>(camera.width), static_cast<float>(camera.height));
+  return d;
+}
+
 TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
   const SyntheticOffice sequence;
   SystemOptions options;
@@ -176,12 +186,7 @@ TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
   EXPECT_GT(walkers.outside_usable, walkers.outside / 2);
 
   // One box over the whole view: nothing outside it could pose the next frame.
-  Detection everything;
-  everything.class_id = 0;
-  everything.class_name = "person";
-  everything.score = 0.9f;
-  everything.box = cv::Rect2f(0, 0, static_cast<float>(sequence.GetCamera().width),
-                              static_cast<float>(sequence.GetCamera().height));
+  const Detection everything = ViewFillingPerson(sequence.GetCamera());
   const FirstMapPoints filled = FirstMap(sequence, first, {everything}, options);
   EXPECT_GT(filled.in_boxes, options.tracking.min_init_points);
   EXPECT_EQ(filled.in_boxes_at_box_prior, 0);
@@ -209,12 +214,7 @@ TEST(TrackingTest, WithoutTheStaticTestTheFirstMapLeavesAWalkersPointsOut) {
   EXPECT_EQ(left_out.in_boxes, 0);
   EXPECT_GT(left_out.outside, options.tracking.min_inliers_after_reloc);
 
-  Detection everything;
-  everything.class_id = 0;
-  everything.class_name = "person";
-  everything.score = 0.9f;
-  everything.box = cv::Rect2f(0, 0, static_cast<float>(sequence.GetCamera().width),
-                              static_cast<float>(sequence.GetCamera().height));
+  const Detection everything = ViewFillingPerson(sequence.GetCamera());
   const FirstMapPoints filled = FirstMap(sequence, first, {everything}, options);
   EXPECT_GT(filled.in_boxes, options.tracking.min_init_points);
 
