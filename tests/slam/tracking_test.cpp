@@ -160,6 +160,12 @@ FirstMapPoints FirstMap(const SyntheticOffice& sequence, size_t frame_index,
   return out;
 }
 
+size_t FirstFrameWithAWalker(const SyntheticOffice& sequence) {
+  size_t first = 0;
+  while (first < sequence.Size() && sequence.Detections(first).empty()) ++first;
+  return first;
+}
+
 // A person's box over the whole view.
 Detection ViewFillingPerson(const Camera& camera) {
   Detection d;
@@ -175,8 +181,7 @@ TEST(TrackingTest, TheFirstMapKeepsAWalkersPointsOutOfThePoseUntilJudged) {
   SystemOptions options;
   options.tracking.first_map_box_prior = true;  // as the indoor RGB-D configs set it
   ASSERT_TRUE(options.tracking.static_test);
-  size_t first = 0;
-  while (first < sequence.Size() && sequence.Detections(first).empty()) ++first;
+  const size_t first = FirstFrameWithAWalker(sequence);
   ASSERT_LT(first, sequence.Size()) << "no frame with a walker in view";
   const FirstMapPoints walkers = FirstMap(sequence, first, sequence.Detections(first), options);
   EXPECT_GT(walkers.in_boxes, 10);
@@ -207,8 +212,7 @@ TEST(TrackingTest, WithoutTheStaticTestTheFirstMapLeavesAWalkersPointsOut) {
   SystemOptions options;
   options.tracking.static_test = false;
   options.tracking.first_map_box_prior = true;  // as network_indoor.yaml sets it
-  size_t first = 0;
-  while (first < sequence.Size() && sequence.Detections(first).empty()) ++first;
+  const size_t first = FirstFrameWithAWalker(sequence);
   ASSERT_LT(first, sequence.Size()) << "no frame with a walker in view";
   const FirstMapPoints left_out = FirstMap(sequence, first, sequence.Detections(first), options);
   EXPECT_EQ(left_out.in_boxes, 0);

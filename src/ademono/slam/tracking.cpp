@@ -316,14 +316,11 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       }
       if (options_.tracking.reseed_after_odometry_frames > 0 &&
           odometry_streak_ >= options_.tracking.reseed_after_odometry_frames &&
-          matches_inliers_ >= options_.tracking.min_inliers_after_reloc &&
-          CountDepthPoints(frame) >= options_.tracking.min_init_points) {
+          matches_inliers_ >= options_.tracking.min_inliers_after_reloc) {
         const Rigid3d cam_from_world = *frame.cam_from_world;
-        frame.map_points.assign(frame.F().Size(), nullptr);
-        frame.outlier.assign(frame.F().Size(), false);
-        if (Initialise(frame, cam_from_world)) {
-          out.reinitialised = true;
-          out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
+        if (RestartAt(frame, cam_from_world, out)) {
+          // Stale outlier flags would drop the new points from the next frame's search.
+          frame.outlier.assign(frame.F().Size(), false);
           weak_streak_ = odometry_streak_ = 0;
         }
       }
@@ -343,15 +340,8 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
       // After a long loss, restart from the last known pose in the same map rather than
       // dropping every following frame (drift instead of a gap).
       if (!odometry_localisation_ && lost_streak_ > options_.tracking.reinit_after_lost_frames &&
-          last_good_pose_ &&
-          CountDepthPoints(frame) >= options_.tracking.min_init_points) {
-        frame.map_points.assign(frame.F().Size(), nullptr);
-        ok = Initialise(frame, *last_good_pose_);
-        if (ok) {
-          out.reinitialised = true;
-          out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
-        }
-      }
+          last_good_pose_)
+        ok = RestartAt(frame, *last_good_pose_, out);
     }
   }
 
@@ -454,6 +444,15 @@ bool Tracking::Initialise(Frame& frame, const Rigid3d& cam_from_world) {
   ForgetMotion();
   state_ = TrackingState::kOk;
   matches_inliers_ = static_cast<int>(local_points_.size());
+  return true;
+}
+
+bool Tracking::RestartAt(Frame& frame, const Rigid3d& cam_from_world, TrackingOutput& out) {
+  if (CountDepthPoints(frame) < options_.tracking.min_init_points) return false;
+  frame.map_points.assign(frame.F().Size(), nullptr);
+  if (!Initialise(frame, cam_from_world)) return false;
+  out.reinitialised = true;
+  out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
   return true;
 }
 

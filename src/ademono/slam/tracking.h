@@ -143,6 +143,11 @@ class Tracking {
 
  private:
   bool Initialise(Frame& frame, const Rigid3d& cam_from_world) ADEMONO_REQUIRES(map_.mutex);
+  // A restart in the same map at `cam_from_world` from the frame's depths (after a long loss, or
+  // a re-seed): its first map's keyframe becomes `out`'s new keyframe. False, and the frame
+  // untouched, when it has too few depths.
+  bool RestartAt(Frame& frame, const Rigid3d& cam_from_world, TrackingOutput& out)
+      ADEMONO_REQUIRES(map_.mutex);
   // Monocular without depth: the two-view initialisation (MonocularInitialization).
   bool InitialiseMonocular(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
   // Whether a new keyframe makes map points from its own depths: always with sensor-like depth;
