@@ -318,11 +318,7 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
           odometry_streak_ >= options_.tracking.reseed_after_odometry_frames &&
           matches_inliers_ >= options_.tracking.min_inliers_after_reloc) {
         const Rigid3d cam_from_world = *frame.cam_from_world;
-        if (RestartAt(frame, cam_from_world, out)) {
-          // Stale outlier flags would drop the new points from the next frame's search.
-          frame.outlier.assign(frame.F().Size(), false);
-          weak_streak_ = odometry_streak_ = 0;
-        }
+        if (RestartAt(frame, cam_from_world, out)) weak_streak_ = odometry_streak_ = 0;
       }
       // Outliers do not carry over to the next frame's motion-model search.
       for (size_t i = 0; i < frame.map_points.size(); ++i) {
@@ -451,6 +447,9 @@ bool Tracking::RestartAt(Frame& frame, const Rigid3d& cam_from_world, TrackingOu
   if (CountDepthPoints(frame) < options_.tracking.min_init_points) return false;
   frame.map_points.assign(frame.F().Size(), nullptr);
   if (!Initialise(frame, cam_from_world)) return false;
+  // The flags of the failed or replaced tracking would drop the new points from the next
+  // frame's search (Matcher::SearchByProjection skips a last-frame outlier).
+  frame.outlier.assign(frame.F().Size(), false);
   out.reinitialised = true;
   out.new_keyframe = map_.GetKeyFrame(frame.reference_keyframe->id);
   return true;
