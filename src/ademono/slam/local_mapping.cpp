@@ -76,9 +76,6 @@ void LocalMapping::InsertKeyFrame(const std::shared_ptr<KeyFrame>& keyframe) {
     if (options_.triangulation) {
       const int created = CreateNewMapPoints(*keyframe);
       spdlog::debug("keyframe {}: {} map points triangulated", keyframe->id, created);
-      if (monocular_ && configured_sigma_log_ > 0 && options_.network_error_model &&
-          sigma_logs_.empty() && !first_sigma_log_)
-        MeasureTriangulatedNetworkError(*keyframe);
     }
     const double structure_ms = MsSinceStart(start);
     FuseNeighbours(*keyframe);
@@ -230,12 +227,6 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
   const PinholeIntrinsics& in = f1.intrinsics;
   const double min_parallax_cos =
       std::cos(options_.triangulation_min_parallax_deg * 3.14159265358979323846 / 180.0);
-  // The monocular core's network depths are judged by their measured spread (about the frame's
-  // scale: this keyframe has no affine map yet), not by the configured error model.
-  const double measured_sigma = monocular_ && configured_sigma_log_ > 0 &&
-                                        options_.network_error_model
-                                    ? NetworkSigmaLog(false)
-                                    : 0.0;
   const float ratio_factor = 1.5f * f1.pyramid->scale_factors.at(std::min<size_t>(
                                         1, f1.pyramid->scale_factors.size() - 1));
   const Eigen::Vector3d center1 = keyframe.CameraCenter();
@@ -257,8 +248,7 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
       continue;
 
     std::vector<std::pair<size_t, size_t>> matches;
-    matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches,
-                                   measured_sigma);
+    matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches);
     const FrameFeatures& f2 = k2->F();
     const Eigen::Vector3d center2 = k2->CameraCenter();
     for (const auto& [i1, i2] : matches) {
@@ -294,9 +284,7 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
       // A depth prior that disagrees by more than its own uncertainty: a wrong match.
       const double sigmas = options_.triangulation_depth_sigmas;
       if (sigmas > 0 && f1.DepthIsPrior() && f1.depth[i1] > 0 &&
-          std::abs(z1 - f1.depth[i1]) >
-              sigmas * (measured_sigma > 0 ? measured_sigma * f1.depth[i1]
-                                           : f1.depth_error.Sigma(f1.depth[i1])))
+          std::abs(z1 - f1.depth[i1]) > sigmas * f1.depth_error.Sigma(f1.depth[i1]))
         continue;
       auto point = map_.CreateMapPoint(*x, &keyframe, keyframe.frame_id);
       point->AddObservation(&keyframe, i1);
@@ -545,19 +533,16 @@ ImageObservation LocalMapping::NetworkPrior(const KeyFrame& kf, size_t i) const 
     const double mapped = kf.network_fit.Map(f.depth[i] / f.depth_scale);
     if (mapped > 0) z = mapped;
   }
-  return f.PriorObservation(i, z, NetworkSigmaLog(kf.network_fit.valid) * z);
+  return f.PriorObservation(i, z, NetworkSigmaLog() * z);
 }
 
-double LocalMapping::NetworkSigmaLog(bool fitted) const {
-  if (!options_.network_error_model) return configured_sigma_log_;
-  const std::vector<double>& measured = fitted ? sigma_logs_ : scale_only_sigma_logs_;
-  if (measured.empty())
-    return (fitted ? first_sigma_log_ : first_scale_only_sigma_log_).value_or(configured_sigma_log_);
+double LocalMapping::NetworkSigmaLog() const {
+  if (sigma_logs_.empty() || !options_.network_error_model) return configured_sigma_log_;
   // The recent keyframes' (the network's error depends on the scene it sees).
   constexpr size_t kRecent = 20;
-  const size_t start = measured.size() > kRecent ? measured.size() - kRecent : 0;
-  return Median(
-      std::vector<double>(measured.begin() + static_cast<long>(start), measured.end()));
+  const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;
+  return Median(std::vector<double>(sigma_logs_.begin() + static_cast<long>(start),
+                                    sigma_logs_.end()));
 }
 
 std::optional<double> LocalMapping::KeyFrameScaleSpread() const {
@@ -589,66 +574,7 @@ bool LocalMapping::PriorActive(const MapPoint& p) const {
   const FrameFeatures& f = ref->F();
   const double sigma_px = f.pyramid->scale_factors[f.keypoints_un[it->second].octave];
   const double sigma_theta = sigma_px / f.intrinsics.fx;
-  return sigma_theta > NetworkSigmaLog(options_.network_error_model && ref->network_fit.valid) *
-                            max_angle;
-}
-
-namespace {
-// The robust spread of log(z_net / z_map) about its median: the network's error once the view's
-// scale alone is taken out.
-double ScaleOnlySpread(const std::vector<double>& map_depths,
-                       const std::vector<double>& network_depths) {
-  std::vector<double> logs;
-  for (size_t i = 0; i < map_depths.size(); ++i) {
-    if (map_depths[i] > 0 && network_depths[i] > 0)
-      logs.push_back(std::log(network_depths[i] / map_depths[i]));
-  }
-  return logs.empty() ? 0.0 : RobustSpread(logs, Median(logs));
-}
-}  // namespace
-
-void LocalMapping::MeasureTriangulatedNetworkError(const KeyFrame& keyframe) {
-  const FrameFeatures& f = keyframe.F();
-  if (!f.DepthIsPrior() || !(f.depth_scale > 0)) return;
-  const PinholeIntrinsics& in = f.intrinsics;
-  const double min_parallax_cos =
-      std::cos(options_.triangulation_min_parallax_deg * 3.14159265358979323846 / 180.0);
-  std::vector<double> map_depths, network_depths;
-  for (size_t i = 0; i < keyframe.map_points.size(); ++i) {
-    const auto& p = keyframe.map_points[i];
-    if (!p || p->bad || !(f.depth[i] > 0) || p->NumObservations() < 2) continue;
-    std::optional<Eigen::Vector3d> x;
-    if (!p->depth_prior) {
-      x = p->position;  // placed by two views already
-    } else {
-      // Placed by the network: its depth from the two keypoints alone, where the views' parallax
-      // is what a new point is triangulated with.
-      const auto it = p->reference ? p->observations.find(p->reference) : p->observations.end();
-      if (it == p->observations.end() || p->reference == &keyframe || p->reference->bad) continue;
-      const KeyFrame& k2 = *p->reference;
-      const cv::KeyPoint& kp1 = f.keypoints_un[i];
-      const cv::KeyPoint& kp2 = k2.F().keypoints_un[it->second];
-      const PinholeIntrinsics& in2 = k2.F().intrinsics;
-      const Eigen::Vector2d n1((kp1.pt.x - in.cx) / in.fx, (kp1.pt.y - in.cy) / in.fy);
-      const Eigen::Vector2d n2((kp2.pt.x - in2.cx) / in2.fx, (kp2.pt.y - in2.cy) / in2.fy);
-      x = TriangulatePoint(keyframe.cam_from_world, k2.cam_from_world, n1, n2);
-      if (!x || ParallaxCosine(keyframe.cam_from_world, k2.cam_from_world, *x) > min_parallax_cos ||
-          !((k2.cam_from_world * *x).z() > 0))
-        continue;
-    }
-    const double z = (keyframe.cam_from_world * *x).z();
-    if (!(z > 0)) continue;
-    map_depths.push_back(z);
-    network_depths.push_back(f.depth[i] / f.depth_scale);
-  }
-  const InverseDepthAffine fit = FitInverseDepthAffine(map_depths, network_depths);
-  if (!fit.valid) return;
-  first_sigma_log_ = fit.sigma_log;
-  first_scale_only_sigma_log_ = ScaleOnlySpread(map_depths, network_depths);
-  spdlog::debug("keyframe {}: network error on its first triangulated points {:.3f} after its "
-                "affine map, {:.3f} about its scale (log, {} points; configured {:.3f})",
-                keyframe.id, fit.sigma_log, *first_scale_only_sigma_log_, map_depths.size(),
-                configured_sigma_log_);
+  return sigma_theta > NetworkSigmaLog() * max_angle;
 }
 
 void LocalMapping::MeasureNetworkErrors(const Pending& pending) {
@@ -671,10 +597,8 @@ void LocalMapping::MeasureNetworkErrors(const Pending& pending) {
     kf.network_fit = fit;
     if (&kf == pending.keyframe.get()) {
       sigma_logs_.push_back(fit.sigma_log);
-      scale_only_sigma_logs_.push_back(ScaleOnlySpread(map_depths, network_depths));
-      spdlog::debug("keyframe {}: network error after its affine map {:.3f}, about its scale "
-                    "{:.3f} (log, {} points)",
-                    kf.id, fit.sigma_log, scale_only_sigma_logs_.back(), map_depths.size());
+      spdlog::debug("keyframe {}: network error after its affine map {:.3f} (log, {} points)",
+                    kf.id, fit.sigma_log, map_depths.size());
     }
   }
 }

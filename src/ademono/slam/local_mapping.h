@@ -61,13 +61,10 @@ class LocalMapping {
   size_t QueueSize() const { return Idle() ? 0 : 1; }
   // Merges the pending keyframe and stops the worker. Idempotent.
   void Shutdown();
-  // Monocular core with a network: the network's per-point error in log depth, measured so far
-  // against triangulated points (after local BA, else on the first points triangulated, before
-  // the first BA; the configured error model's only while nothing is triangulated). `fitted`:
-  // for a keyframe with its own affine map, the spread left after it
-  // (InverseDepthAffine::sigma_log); else the spread about the keyframe's scale alone, which
-  // also holds the distortion an affine map would take out.
-  double NetworkSigmaLog(bool fitted = true) const;
+  // Monocular core with a network: the network's per-point error (robust spread of log depth
+  // after each keyframe's affine map, InverseDepthAffine::sigma_log) measured so far against
+  // triangulated points, or the configured error model's until there is a measurement.
+  double NetworkSigmaLog() const;
   // Monocular core with a network: keypoint i of `kf` with its network depth as a prior
   // observation (the keyframe's fitted error model applied when it has one).
   ImageObservation NetworkPrior(const KeyFrame& kf, size_t i) const ADEMONO_REQUIRES(map_.mutex);
@@ -113,19 +110,12 @@ class LocalMapping {
   // Fits each BA keyframe's network error model against its triangulated points (monocular core
   // with a network) and updates the measured per-point spread.
   void MeasureNetworkErrors(const Pending& pending) ADEMONO_REQUIRES(map_.mutex);
-  // Before any BA has been measured: the network's spread against the points just triangulated
-  // in `keyframe` (their positions before BA), so that the first BA's priors are weighted by a
-  // measurement too. Stores it in first_sigma_log_ when the fit is valid.
-  void MeasureTriangulatedNetworkError(const KeyFrame& keyframe) ADEMONO_REQUIRES(map_.mutex);
 
   Map& map_;
   MappingOptions options_;
   bool monocular_ = false;
   double configured_sigma_log_ = 0.0;  // the options' error model, until measured
-  // Per fitted keyframe (tracking thread): the spread after its affine map, and about its scale.
-  std::vector<double> sigma_logs_, scale_only_sigma_logs_;
-  // The same on the first triangulated points, before any BA.
-  std::optional<double> first_sigma_log_, first_scale_only_sigma_log_;
+  std::vector<double> sigma_logs_;     // per fitted keyframe (tracking thread)
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
   LoopClosing* loop_closing_ = nullptr;
   std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below

@@ -314,8 +314,7 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
 }
 
 int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
-                                    std::vector<std::pair<size_t, size_t>>& matches,
-                                    double relative_sigma) const {
+                                    std::vector<std::pair<size_t, size_t>>& matches) const {
   const FrameFeatures& f1 = k1.F();
   const FrameFeatures& f2 = k2.F();
   const PinholeIntrinsics& in1 = f1.intrinsics;
@@ -372,7 +371,7 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
     Eigen::Vector2d seg_a, seg_b;
     if (depth_sigmas > 0 && f1.depth[i] > 0 && f1.DepthIsPrior()) {
       const double z = f1.depth[i];
-      const double sigma = relative_sigma > 0 ? relative_sigma * z : f1.depth_error.Sigma(z);
+      const double sigma = f1.depth_error.Sigma(z);
       const double z_near = std::max(0.05, z - depth_sigmas * sigma);
       const double z_far = z + depth_sigmas * sigma;
       const Eigen::Vector3d ray = K1inv * x1;

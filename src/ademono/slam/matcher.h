@@ -56,13 +56,10 @@ class Matcher {
   // `k2` that have no map point yet, matched by descriptor (best below kOrbDistanceLow, ratio test,
   // rotation check) among the candidates within the epipolar band of k2 (chi2 3.84 at the
   // candidate's level). A k1 keypoint with a depth prior only searches the part of its epipolar
-  // line within `depth_sigmas` sigma of that depth (the whole line without one); the sigma is
-  // `relative_sigma` times the depth when that is > 0 (a measured error), else the frame's
-  // configured error model's. Appends (k1 index, k2 index) pairs, each k2 keypoint at most once,
-  // and returns their number.
+  // line within `depth_sigmas` sigma of that depth (the whole line without one). Appends
+  // (k1 index, k2 index) pairs, each k2 keypoint at most once, and returns their number.
   int SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
-                             std::vector<std::pair<size_t, size_t>>& matches,
-                             double relative_sigma = 0.0) const;
+                             std::vector<std::pair<size_t, size_t>>& matches) const;
 
   // Monocular initialisation (ORB-SLAM's SearchForInitialization): every keypoint of `f1` is
   // matched with the best keypoint of `f2` on the same pyramid level within `window` px (level 0)
