@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "ademono/slam/map_point.h"
 
@@ -84,9 +85,12 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
     }
   }
 
-  f->grid.assign(FrameFeatures::kGridCols * FrameFeatures::kGridRows, {});
+  // Counting sort by cell, keypoints in index order within each.
+  constexpr int kCells = FrameFeatures::kGridCols * FrameFeatures::kGridRows;
   const float cell_w = (f->max_x - f->min_x) / FrameFeatures::kGridCols;
   const float cell_h = (f->max_y - f->min_y) / FrameFeatures::kGridRows;
+  std::vector<int> cell_of(n, -1);
+  f->grid_begin.assign(kCells + 1, 0);
   for (size_t i = 0; i < n; ++i) {
     const cv::Point2f& p = f->keypoints_un[i].pt;
     // Compared as floats before the cast: a far outlier would overflow int (undefined).
@@ -94,8 +98,16 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
     const float gy = std::floor((p.y - f->min_y) / cell_h);
     if (!(gx >= 0.f && gx < FrameFeatures::kGridCols && gy >= 0.f && gy < FrameFeatures::kGridRows))
       continue;
-    const int cx = static_cast<int>(gx), cy = static_cast<int>(gy);
-    f->grid[cy * FrameFeatures::kGridCols + cx].push_back(i);
+    cell_of[i] = static_cast<int>(gy) * FrameFeatures::kGridCols + static_cast<int>(gx);
+    ++f->grid_begin[cell_of[i] + 1];
+  }
+  for (int c = 0; c < kCells; ++c) f->grid_begin[c + 1] += f->grid_begin[c];
+  f->grid_entries.resize(f->grid_begin[kCells]);
+  std::vector<uint32_t> fill(f->grid_begin.begin(), f->grid_begin.end() - 1);
+  for (size_t i = 0; i < n; ++i) {
+    if (cell_of[i] < 0) continue;
+    const cv::KeyPoint& kp = f->keypoints_un[i];
+    f->grid_entries[fill[cell_of[i]]++] = {kp.pt.x, kp.pt.y, kp.octave, static_cast<uint32_t>(i)};
   }
   return f;
 }
@@ -134,26 +146,33 @@ std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features,
 std::vector<size_t> FrameFeatures::FeaturesInArea(float u, float v, float r, int min_level,
                                                   int max_level) const {
   std::vector<size_t> result;
-  if (grid.empty()) return result;  // features without keypoints (a culled keyframe)
+  FeaturesInArea(u, v, r, min_level, max_level, &result);
+  return result;
+}
+
+void FrameFeatures::FeaturesInArea(float u, float v, float r, int min_level, int max_level,
+                                   std::vector<size_t>* out) const {
+  out->clear();
+  if (grid_begin.empty()) return;  // features without keypoints (a culled keyframe)
   const float cell_w = (max_x - min_x) / kGridCols;
   const float cell_h = (max_y - min_y) / kGridRows;
   const int x0 = std::max(0, static_cast<int>(std::floor((u - min_x - r) / cell_w)));
   const int x1 = std::min(kGridCols - 1, static_cast<int>(std::ceil((u - min_x + r) / cell_w)));
   const int y0 = std::max(0, static_cast<int>(std::floor((v - min_y - r) / cell_h)));
   const int y1 = std::min(kGridRows - 1, static_cast<int>(std::ceil((v - min_y + r) / cell_h)));
-  if (x0 > x1 || y0 > y1) return result;
+  if (x0 > x1 || y0 > y1) return;
+  const int lo = min_level >= 0 ? min_level : std::numeric_limits<int>::min();
+  const int hi = max_level >= 0 ? max_level : std::numeric_limits<int>::max();
   for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      for (size_t i : grid[y * kGridCols + x]) {
-        const cv::KeyPoint& kp = keypoints_un[i];
-        if (min_level >= 0 && kp.octave < min_level) continue;
-        if (max_level >= 0 && kp.octave > max_level) continue;
-        if (std::abs(kp.pt.x - u) < r && std::abs(kp.pt.y - v) < r) result.push_back(i);
-      }
+    // Cells x0..x1 of a row are contiguous.
+    const GridEntry* e = grid_entries.data() + grid_begin[y * kGridCols + x0];
+    const GridEntry* end = grid_entries.data() + grid_begin[y * kGridCols + x1 + 1];
+    for (; e != end; ++e) {
+      if (e->octave < lo || e->octave > hi) continue;
+      if (std::abs(e->x - u) < r && std::abs(e->y - v) < r) out->push_back(e->index);
     }
   }
-  std::sort(result.begin(), result.end());
-  return result;
+  std::sort(out->begin(), out->end());
 }
 
 ImageObservation FrameFeatures::Observation(size_t i) const {

@@ -22,7 +22,10 @@ int BestInArea(const FrameFeatures& f, const cv::Mat& descriptor,
   const int level = prediction.level;
   int best_dist = 256, best_level = -1, best_dist2 = 256, best_level2 = -1;
   int best_idx = -1;
-  for (size_t idx : f.FeaturesInArea(prediction.u, prediction.v, r, level - 1, level)) {
+  // Called for every projected map point: the candidates' buffer is reused.
+  thread_local std::vector<size_t> candidates;
+  f.FeaturesInArea(prediction.u, prediction.v, r, level - 1, level, &candidates);
+  for (size_t idx : candidates) {
     if (skip(idx)) continue;
     const int d = DescriptorDistance(descriptor, f.descriptors.row(static_cast<int>(idx)));
     if (d < best_dist) {
@@ -56,6 +59,7 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
 
   RotationHistogram rotations;
   int matches = 0;
+  std::vector<size_t> candidates;
   for (size_t i = 0; i < last.map_points.size(); ++i) {
     const auto& point = last.map_points[i];
     if (!point || last.outlier[i] || point->bad) continue;
@@ -67,13 +71,12 @@ int Matcher::SearchByProjection(Frame& current, const Frame& last, float radius)
     if (!cf.InBounds(u, v)) continue;
     const int last_octave = lf.keypoints_un[i].octave;
     const float r = radius * cf.pyramid->scale_factors[last_octave];
-    std::vector<size_t> candidates;
     if (forward) {
-      candidates = cf.FeaturesInArea(u, v, r, last_octave);
+      cf.FeaturesInArea(u, v, r, last_octave, -1, &candidates);
     } else if (backward) {
-      candidates = cf.FeaturesInArea(u, v, r, 0, last_octave);
+      cf.FeaturesInArea(u, v, r, 0, last_octave, &candidates);
     } else {
-      candidates = cf.FeaturesInArea(u, v, r, last_octave - 1, last_octave + 1);
+      cf.FeaturesInArea(u, v, r, last_octave - 1, last_octave + 1, &candidates);
     }
     const float ur = static_cast<float>(u - cf.intrinsics.bf * inv_z);
     int best_dist = 256;
@@ -245,6 +248,7 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
   const Rigid3d& cam_from_world = keyframe.cam_from_world;
   const Eigen::Vector3d center = keyframe.CameraCenter();
   int fused = 0;
+  std::vector<size_t> candidates;
   for (const auto& point : points) {
     if (!point || point->bad || point->IsInKeyFrame(&keyframe)) continue;
     const Eigen::Vector3d pc = cam_from_world * point->position;
@@ -262,7 +266,8 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
     const float r = radius * f.pyramid->scale_factors[level];
     int best_dist = 256;
     size_t best_idx = 0;
-    for (size_t idx : f.FeaturesInArea(u, v, r)) {
+    f.FeaturesInArea(u, v, r, -1, -1, &candidates);
+    for (size_t idx : candidates) {
       const cv::KeyPoint& kp = f.keypoints_un[idx];
       if (kp.octave < level - 1 || kp.octave > level) continue;
       const float ex = u - kp.pt.x, ey = v - kp.pt.y;
@@ -444,11 +449,11 @@ int Matcher::SearchForInitialization(const FrameFeatures& f1, const FrameFeature
   matches12.assign(f1.Size(), -1);
   std::vector<int> matches21(f2.Size(), -1), distance21(f2.Size(), INT32_MAX);
   RotationHistogram rotations;
+  std::vector<size_t> candidates;
   for (size_t i = 0; i < f1.Size(); ++i) {
     const cv::KeyPoint& kp1 = f1.keypoints_un[i];
     const int level = kp1.octave;
-    const std::vector<size_t> candidates =
-        f2.FeaturesInArea(prev_matched[i].x, prev_matched[i].y, window, level, level);
+    f2.FeaturesInArea(prev_matched[i].x, prev_matched[i].y, window, level, level, &candidates);
     if (candidates.empty()) continue;
     const cv::Mat d1 = f1.descriptors.row(static_cast<int>(i));
     int best = INT32_MAX, second = INT32_MAX;
