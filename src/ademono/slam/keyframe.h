@@ -66,6 +66,10 @@ class KeyFrame {
 
   // Scratch of the tracker and local mapping.
   uint64_t local_map_frame = UINT64_MAX;
+  // Tracking's count of a frame's points this keyframe sees (valid while counted_for is the
+  // count's stamp): a scratch field, so the count needs no map per frame.
+  uint64_t counted_for = UINT64_MAX;
+  int counted_points = 0;
   uint64_t ba_local_for = UINT64_MAX;
   uint64_t fuse_target_for = UINT64_MAX;
 

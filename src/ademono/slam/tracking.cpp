@@ -770,26 +770,37 @@ bool Tracking::TrackReferenceKeyFrame(Frame& frame) {
 
 void Tracking::UpdateLocalMap(Frame& frame) {
   // Keyframes that see the frame's points, weighted by how many; the best is the reference.
-  std::map<KeyFrame*, int, KeyFrameIdLess> counter;
+  // Counted in each keyframe's scratch field, then walked in id order (deterministic).
+  std::vector<KeyFrame*> counted;
+  const uint64_t stamp = ++count_stamp_;  // this call's: a frame may be counted twice
+  auto count = [&](KeyFrame* kf) {
+    if (kf->counted_for != stamp) {
+      kf->counted_for = stamp;
+      kf->counted_points = 0;
+      counted.push_back(kf);
+    }
+    ++kf->counted_points;
+  };
   for (size_t i = 0; i < frame.map_points.size(); ++i) {
     const auto& p = frame.map_points[i];
     if (!p || p->bad) continue;
-    for (const auto& [kf, idx] : p->observations) ++counter[kf];
+    for (const auto& [kf, idx] : p->observations) count(kf);
   }
   local_keyframes_.clear();
   // Localisation only, off the map (odometry points alone): the reference keyframe's
   // neighbourhood is the local map, where the map is most likely to come back into view.
-  if (counter.empty() && odometry_localisation_ && reference_keyframe_ != nullptr &&
+  if (counted.empty() && odometry_localisation_ && reference_keyframe_ != nullptr &&
       !reference_keyframe_->bad) {
-    counter[reference_keyframe_] = 1;
+    count(reference_keyframe_);
   }
-  if (counter.empty()) return;
+  if (counted.empty()) return;
+  std::sort(counted.begin(), counted.end(), KeyFrameIdLess());
   KeyFrame* best = nullptr;
   int best_count = 0;
-  for (const auto& [kf, count] : counter) {
+  for (KeyFrame* kf : counted) {
     if (kf->bad) continue;
-    if (count > best_count) {
-      best_count = count;
+    if (kf->counted_points > best_count) {
+      best_count = kf->counted_points;
       best = kf;
     }
     kf->local_map_frame = frame.id;
