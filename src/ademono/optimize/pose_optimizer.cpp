@@ -1,6 +1,7 @@
 #include "ademono/optimize/pose_optimizer.h"
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 
@@ -60,9 +61,11 @@ inline double Huber(double s, double a2, bool robust, double* rho1) {
 // 1/2 sum rho(|r|^2) at `camera`; with h and g also J^T W J and J^T W r (W = rho').
 double LmEvaluate(const LmProblem& p, const double* camera, Matrix6* h, Vector6* g) {
   double cost = 0;
+  std::optional<internal::CameraRotation> rotation;  // one camera: its rotation once
   if (h != nullptr) {
     h->setZero();
     g->setZero();
+    rotation.emplace(camera);
   }
   auto add = [&](const auto& residuals, const std::vector<Eigen::Vector3d>& points, double a2) {
     constexpr int kDim = std::decay_t<decltype(residuals[0])>::kDimension;
@@ -70,7 +73,8 @@ double LmEvaluate(const LmProblem& p, const double* camera, Matrix6* h, Vector6*
       Eigen::Matrix<double, kDim, 1> r;
       Eigen::Matrix<double, kDim, 6, Eigen::RowMajor> j;
       internal::EvaluateProjection<kDim>(residuals[i], camera, points[i].data(), r.data(),
-                                         h != nullptr ? j.data() : nullptr, nullptr);
+                                         h != nullptr ? j.data() : nullptr, nullptr,
+                                         rotation ? &*rotation : nullptr);
       double rho1 = 1;
       cost += 0.5 * Huber(r.squaredNorm(), a2, p.robust, &rho1);
       if (h != nullptr) {

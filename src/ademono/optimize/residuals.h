@@ -173,18 +173,24 @@ void ProjectRotated(const ProjectionResidual<kDim>& r, const double* q, const do
 // The same residual with closed-form Jacobians (about 3x cheaper than auto-diff's dual numbers).
 // camera = (omega, t) of cam_from_world: p = R(omega) X + t, so dp/domega is d(R X)/d omega
 // (CameraRotation), dp/dt = I and dp/dX = R.
+// `rotation`, when given, is CameraRotation(camera), built once by a caller that evaluates many
+// points with one camera (the same numbers as building it here).
 template <int kDim>
 void EvaluateProjection(const ProjectionResidual<kDim>& r, const double* camera,
                         const double* point_world, double* residual, double* jac_camera,
-                        double* jac_point) {
+                        double* jac_point, const CameraRotation* rotation = nullptr) {
   double q[3];
   ceres::AngleAxisRotatePoint(camera, point_world, q);
   if (jac_camera == nullptr && jac_point == nullptr) {
     ProjectRotated(r, q, camera + 3, point_world, nullptr, residual, nullptr, nullptr);
     return;
   }
-  const CameraRotation rotation(camera);
-  ProjectRotated(r, q, camera + 3, point_world, &rotation, residual, jac_camera, jac_point);
+  if (rotation != nullptr) {
+    ProjectRotated(r, q, camera + 3, point_world, rotation, residual, jac_camera, jac_point);
+    return;
+  }
+  const CameraRotation own(camera);
+  ProjectRotated(r, q, camera + 3, point_world, &own, residual, jac_camera, jac_point);
 }
 
 // Bundle adjustment cost with analytic Jacobians (parameter blocks: camera 6, point 3).
