@@ -15,9 +15,8 @@ int main(int argc, char** argv) {
   // environment wins.
   ademono::LimitMallocArenas(2);
   // Large buffers stay in the heap: without it a seq-a run spends 13-15 % of its wall time on
-  // page faults (docs/performance.md "Page faults").
-  ademono::KeepLargeBuffersInTheHeap(ademono::kMmapThresholdBytes,
-                                     ademono::kTrimThresholdBytes);
+  // page faults (docs/performance.md "Page faults and the tree walk").
+  ademono::KeepLargeBuffersInTheHeap(ademono::kMmapThresholdBytes, ademono::kTrimThresholdBytes);
   CLI::App app{
       "ademono: monocular SLAM with metric depth, dynamic-object and distant-point filtering"};
   app.require_subcommand(1);

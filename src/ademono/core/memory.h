@@ -20,10 +20,10 @@ bool LimitMallocArenas(int arenas);
 // more on its own and gives a freed heap top back at once, so every local BA's linearisation
 // (2-3 MB, allocated and freed per keyframe) and every frame's image buffers fault their pages
 // in again: 150,000-190,000 minor page faults and about 2 s of system time on seq-a, 13-15 % of
-// the run's wall time (docs/performance.md "Page faults"). Long runs still return freed memory
-// through ReleaseFreedMemory. Process-wide, like LimitMallocArenas, and skipped when the
-// environment sets either threshold (MALLOC_MMAP_THRESHOLD_, MALLOC_TRIM_THRESHOLD_ or
-// GLIBC_TUNABLES). Returns whether both were applied.
+// the run's wall time (docs/performance.md "Page faults and the tree walk"). Long runs still
+// return freed memory through ReleaseFreedMemory. Process-wide, like LimitMallocArenas, and
+// skipped when the environment sets either threshold (MALLOC_MMAP_THRESHOLD_,
+// MALLOC_TRIM_THRESHOLD_ or GLIBC_TUNABLES). Returns whether both were applied.
 bool KeepLargeBuffersInTheHeap(size_t mmap_bytes, size_t trim_bytes);
 inline constexpr size_t kMmapThresholdBytes = size_t{4} << 20;
 inline constexpr size_t kTrimThresholdBytes = size_t{32} << 20;
