@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -772,7 +773,11 @@ void Tracking::UpdateLocalMap(Frame& frame) {
   // Keyframes that see the frame's points, weighted by how many; the best is the reference.
   // Counted in each keyframe's scratch field, then walked in id order (deterministic).
   std::vector<KeyFrame*> counted;
-  const uint64_t stamp = ++count_stamp_;  // this call's: a frame may be counted twice
+  // Unique to this call in the whole process (a frame may be counted twice, and another tracker
+  // may have stamped the same keyframes); only equality matters, so the value is deterministic in
+  // effect.
+  static std::atomic<uint64_t> last_stamp{0};
+  const uint64_t stamp = last_stamp.fetch_add(1, std::memory_order_relaxed) + 1;
   auto count = [&](KeyFrame* kf) {
     if (kf->counted_for != stamp) {
       kf->counted_for = stamp;

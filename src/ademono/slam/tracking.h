@@ -271,7 +271,6 @@ class Tracking {
   // matched no map point, so the next frame can track by odometry where the map does not reach.
   void AddVisualOdometryPoints(Frame& frame);
   std::vector<KeyFrame*> local_keyframes_;
-  uint64_t count_stamp_ = 0;  // UpdateLocalMap's stamp of KeyFrame::counted_for
   std::vector<std::shared_ptr<MapPoint>> local_points_;
   // tracking.interpolate_trajectory: `record` (about to be pushed) is anchored to the newest
   // keyframe, and the records since the previous keyframe to `new_keyframe` when one was made.
