@@ -67,9 +67,13 @@ def rms(r):
 
 
 def main():
-    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
+    if len(sys.argv) < 2:
+        print("ate_lever_arm: no run folder given (usage: tools/ate_lever_arm.py RUN_DIR...)",
+              file=sys.stderr)
+        sys.exit(2)
+    if sys.argv[1] in ("-h", "--help"):
         print(__doc__.strip())
-        sys.exit(0 if len(sys.argv) > 1 else 2)
+        sys.exit(0)
     rows = []  # printed once every run is read: a bad run leaves no half table
     for run in sys.argv[1:]:
         est = load_tum(os.path.join(run, "trajectory.tum"))

@@ -3,9 +3,9 @@
 // leave no error; without an offset it must fit none. Bad input exits 2 with one line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -13,31 +13,25 @@
 #include <iomanip>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "cli_test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using ademono::cli_test::CliRun;
+using ademono::cli_test::FreshTempDir;
+using ademono::cli_test::RunCommand;
 using ::testing::HasSubstr;
 
 const fs::path kTool = fs::path(ADEMONO_SOURCE_DIR) / "tools" / "ate_lever_arm.py";
 
 bool HaveNumpy() { return std::system("/usr/bin/python3 -c 'import numpy' >/dev/null 2>&1") == 0; }
 
-std::string Read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-int RunTool(const std::string& args, const fs::path& dir, std::string* out, std::string* err) {
-  const std::string cmd = "/usr/bin/python3 " + kTool.string() + " " + args + " >" +
-                          (dir / "o.txt").string() + " 2>" + (dir / "e.txt").string();
-  const int status = std::system(cmd.c_str());
-  *out = Read(dir / "o.txt");
-  *err = Read(dir / "e.txt");
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+CliRun RunTool(const std::string& args, const fs::path& dir) {
+  return RunCommand("/usr/bin/python3 " + kTool.string() + " " + args, dir);
 }
 
 void WriteTum(std::ofstream& out, int i, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
@@ -86,37 +80,35 @@ std::vector<double> Row(const std::string& out, const fs::path& run) {
 
 TEST(AteLeverArmTest, RecoversAKnownOffsetAndFitsNoneWhereThereIsNone) {
   if (!HaveNumpy()) GTEST_SKIP() << "no numpy";
-  const fs::path dir = fs::temp_directory_path() / ("ademono_lever_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = FreshTempDir("lever");
   WriteRun(dir / "offset", Eigen::Vector3d(0.02, 0.10, -0.07));
   WriteRun(dir / "exact", Eigen::Vector3d::Zero());
-  std::string out, err;
-  ASSERT_EQ(RunTool((dir / "offset").string() + " " + (dir / "exact").string(), dir, &out, &err), 0)
-      << err;
-  const std::vector<double> offset = Row(out, dir / "offset");
-  ASSERT_EQ(offset.size(), 6u) << out;
+  CliRun run = RunTool((dir / "offset").string() + " " + (dir / "exact").string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::vector<double> offset = Row(run.out, dir / "offset");
+  ASSERT_EQ(offset.size(), 6u) << run.out;
   EXPECT_GT(offset[0], 0.01);  // a sim3 alone cannot take out an offset that turns
   EXPECT_LT(offset[1], 1e-3);  // printed to 4 decimals
   EXPECT_NEAR(offset[2], 0.02, 1e-3);
   EXPECT_NEAR(offset[3], 0.10, 1e-3);
   EXPECT_NEAR(offset[4], -0.07, 1e-3);
-  const std::vector<double> exact = Row(out, dir / "exact");
-  ASSERT_EQ(exact.size(), 6u) << out;
+  const std::vector<double> exact = Row(run.out, dir / "exact");
+  ASSERT_EQ(exact.size(), 6u) << run.out;
   EXPECT_LT(exact[0], 1e-3);
   EXPECT_LT(exact[5], 1e-3);
 
   // A missing run folder: exit 2, one line naming the file, no table.
-  EXPECT_EQ(RunTool((dir / "offset").string() + " " + (dir / "missing").string(), dir, &out, &err),
-            2);
-  EXPECT_THAT(err, HasSubstr((dir / "missing" / "trajectory.tum").string()));
-  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1);
-  EXPECT_EQ(out, "");
+  run = RunTool((dir / "offset").string() + " " + (dir / "missing").string(), dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr((dir / "missing" / "trajectory.tum").string()));
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+  EXPECT_EQ(run.out, "");
   // A malformed line.
   std::ofstream(dir / "offset" / "groundtruth.tum", std::ios::app) << "1.0 2.0 oops\n";
-  EXPECT_EQ(RunTool((dir / "offset").string(), dir, &out, &err), 2);
-  EXPECT_THAT(err, HasSubstr("groundtruth.tum: line 201: expected 8 columns"));
-  EXPECT_EQ(out, "");
+  run = RunTool((dir / "offset").string(), dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("groundtruth.tum: line 201: expected 8 columns"));
+  EXPECT_EQ(run.out, "");
   fs::remove_all(dir);
 }
 

@@ -41,12 +41,11 @@ inline std::string ReadFile(const std::filesystem::path& path) {
   return ss.str();
 }
 
-// Runs `ademono ARGS` with stdout and stderr captured through files in `scratch_dir`.
-inline CliRun RunAdemono(const std::string& args, const std::filesystem::path& scratch_dir) {
+// Runs a shell command (a tool of tools/, say) with stdout and stderr captured through files in
+// `scratch_dir`.
+inline CliRun RunCommand(const std::string& command, const std::filesystem::path& scratch_dir) {
   const auto out = scratch_dir / "stdout.txt", err = scratch_dir / "stderr.txt";
-  const std::string command =
-      std::string(ADEMONO_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
+  const int status = std::system((command + " >" + out.string() + " 2>" + err.string()).c_str());
   CliRun result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   result.out = ReadFile(out);
@@ -54,6 +53,11 @@ inline CliRun RunAdemono(const std::string& args, const std::filesystem::path& s
   std::filesystem::remove(out);
   std::filesystem::remove(err);
   return result;
+}
+
+// Runs `ademono ARGS` with stdout and stderr captured through files in `scratch_dir`.
+inline CliRun RunAdemono(const std::string& args, const std::filesystem::path& scratch_dir) {
+  return RunCommand(std::string(ADEMONO_CLI) + " " + args, scratch_dir);
 }
 
 inline std::filesystem::path FreshTempDir(const std::string& name) {
