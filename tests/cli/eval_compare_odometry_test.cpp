@@ -3,7 +3,6 @@
 // CLI, and puts an --extra trajectory in the same table. Bad input exits 2 with one message.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -11,10 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli_test_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
+namespace cli_test = ademono::cli_test;
 using ::testing::HasSubstr;
 
 const fs::path kSeq = fs::path(ADEMONO_SHARED_DIR) / "data" / "7scenes-seq-a";
@@ -24,27 +26,18 @@ bool HavePythonDeps() {
   return std::system("/usr/bin/python3 -c 'import cv2, numpy; cv2.rgbd' >/dev/null 2>&1") == 0;
 }
 
-std::string Read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
+// The tool with stdout and stderr captured separately.
 int RunTool(const std::string& args, const fs::path& dir, std::string* out, std::string* err) {
-  const std::string cmd = "/usr/bin/python3 " + kTool.string() + " --ademono " + ADEMONO_CLI + " " +
-                          args + " >" + (dir / "o.txt").string() + " 2>" + (dir / "e.txt").string();
-  const int status = std::system(cmd.c_str());
-  *out = Read(dir / "o.txt");
-  *err = Read(dir / "e.txt");
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  const cli_test::CliRun run = cli_test::RunCommand(
+      "/usr/bin/python3 " + kTool.string() + " --ademono " + ADEMONO_CLI + " " + args, dir);
+  *out = run.out;
+  *err = run.err;
+  return run.exit_code;
 }
 
 TEST(CompareOdometryTest, ScoresOpenCvOdometryAndAnExtraTrajectory) {
   if (!fs::exists(kSeq) || !HavePythonDeps()) GTEST_SKIP() << "no 7-Scenes data or cv2.rgbd";
-  const fs::path dir = fs::temp_directory_path() / ("ademono_cmp_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = cli_test::FreshTempDir("cmp");
   // The extra trajectory: the ground truth itself, shifted by 1 cm along x (ATE 0 after se3).
   std::string out, err;
   ASSERT_EQ(RunTool("--sequence " + kSeq.string() + " --out " + (dir / "cmp").string() +
@@ -55,7 +48,7 @@ TEST(CompareOdometryTest, ScoresOpenCvOdometryAndAnExtraTrajectory) {
   EXPECT_THAT(out, HasSubstr("| cv_rgbd |"));
   ASSERT_TRUE(fs::exists(dir / "cmp" / "groundtruth.txt"));
   ASSERT_TRUE(fs::exists(dir / "cmp" / "cv_rgbd.txt"));
-  const nlohmann::json table = nlohmann::json::parse(Read(dir / "t.json"));
+  const nlohmann::json table = nlohmann::json::parse(cli_test::ReadFile(dir / "t.json"));
   ASSERT_EQ(table["rows"].size(), 1u);
   EXPECT_EQ(table["rows"][0]["matched"], 4);
   // Four frames barely move: frame-to-frame odometry stays within a centimetre.
@@ -79,7 +72,7 @@ TEST(CompareOdometryTest, ScoresOpenCvOdometryAndAnExtraTrajectory) {
                     dir, &out, &err),
             0)
       << err;
-  const nlohmann::json both = nlohmann::json::parse(Read(dir / "t.json"));
+  const nlohmann::json both = nlohmann::json::parse(cli_test::ReadFile(dir / "t.json"));
   ASSERT_EQ(both["rows"].size(), 2u);
   EXPECT_EQ(both["rows"][1]["method"], "shifted");
   EXPECT_LT(both["rows"][1]["ate_rmse"].get<double>(), 1e-6);

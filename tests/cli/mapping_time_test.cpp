@@ -3,7 +3,6 @@
 // is the larger problem, and bad input exits 1 with one message naming the file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -12,26 +11,17 @@
 #include <sstream>
 #include <string>
 
+#include "cli_test_util.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
+namespace cli_test = ademono::cli_test;
 using ::testing::HasSubstr;
 
 const fs::path kSeq = fs::path(ADEMONO_SHARED_DIR) / "data" / "7scenes-seq-a";
 const fs::path kTool = fs::path(ADEMONO_SOURCE_DIR) / "tools" / "mapping_time.py";
-
-std::string Read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-int Shell(const std::string& cmd) {
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 // The table's row `name`, one number per column.
 std::vector<double> Row(const std::string& table, const std::string& name) {
@@ -51,24 +41,24 @@ std::vector<double> Row(const std::string& table, const std::string& name) {
 
 TEST(MappingTimeTest, SumsTheKeyFramesOfSensorAndGeometricRuns) {
   if (!fs::exists(kSeq)) GTEST_SKIP() << "no 7-Scenes data";
-  const fs::path dir = fs::temp_directory_path() / ("ademono_mt_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = cli_test::FreshTempDir("mt");
   for (const std::string depth : {"sensor", "none"}) {
-    ASSERT_EQ(Shell(std::string(ADEMONO_CLI) + " --log-level debug run --dataset 7scenes:" +
-                    kSeq.string() + " --frames 0:150 --depth " + depth + " --out " +
-                    (dir / depth).string() + " > " + (dir / (depth + ".log")).string() + " 2>&1"),
-              0)
-        << Read(dir / (depth + ".log"));
+    const cli_test::CliRun run = cli_test::RunAdemono(
+        "--log-level debug run --dataset 7scenes:" + kSeq.string() + " --frames 0:150 --depth " +
+            depth + " --out " + (dir / depth).string(),
+        dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    std::ofstream(dir / (depth + ".log")) << run.out << run.err;
   }
-  ASSERT_EQ(Shell("/usr/bin/python3 " + kTool.string() + " " + (dir / "sensor.log").string() + " " +
-                  (dir / "none.log").string() + " > " + (dir / "t.md").string()),
-            0);
-  const std::string table = Read(dir / "t.md");
+  const std::string tool = "/usr/bin/python3 " + kTool.string() + " ";
+  const cli_test::CliRun mapping_time = cli_test::RunCommand(
+      tool + (dir / "sensor.log").string() + " " + (dir / "none.log").string(), dir);
+  ASSERT_EQ(mapping_time.exit_code, 0) << mapping_time.err;
+  const std::string& table = mapping_time.out;
   const std::vector<double> keyframes = Row(table, "keyframes");
   ASSERT_EQ(keyframes.size(), 2u) << table;
   for (int k = 0; k < 2; ++k) {
-    const std::string log = Read(dir / (k == 0 ? "sensor.log" : "none.log"));
+    const std::string log = cli_test::ReadFile(dir / (k == 0 ? "sensor.log" : "none.log"));
     const std::regex line("keyframe \\d+: structure");
     const auto n =
         std::distance(std::sregex_iterator(log.begin(), log.end(), line), std::sregex_iterator());
@@ -86,15 +76,13 @@ TEST(MappingTimeTest, SumsTheKeyFramesOfSensorAndGeometricRuns) {
   EXPECT_GE(total[1], structure[1]);
   EXPECT_GT(structure[1], 0);
 
-  EXPECT_EQ(Shell("/usr/bin/python3 " + kTool.string() + " " + (dir / "nope.log").string() +
-                  " 2> " + (dir / "e.txt").string()),
-            1);
-  EXPECT_THAT(Read(dir / "e.txt"), HasSubstr((dir / "nope.log").string() + ": No such file"));
+  const cli_test::CliRun missing = cli_test::RunCommand(tool + (dir / "nope.log").string(), dir);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.err, HasSubstr((dir / "nope.log").string() + ": No such file"));
   std::ofstream(dir / "empty.log") << "[info] nothing\n";
-  EXPECT_EQ(Shell("/usr/bin/python3 " + kTool.string() + " " + (dir / "empty.log").string() +
-                  " 2> " + (dir / "e.txt").string()),
-            1);
-  EXPECT_THAT(Read(dir / "e.txt"), HasSubstr("empty.log: no keyframe lines"));
+  const cli_test::CliRun empty = cli_test::RunCommand(tool + (dir / "empty.log").string(), dir);
+  EXPECT_EQ(empty.exit_code, 1);
+  EXPECT_THAT(empty.err, HasSubstr("empty.log: no keyframe lines"));
   fs::remove_all(dir);
 }
 
