@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "ademono/core/worker_pool.h"
 #include "frame_test_util.h"
 
 namespace ademono {
@@ -152,6 +153,52 @@ TEST(MatcherTest, TriangulationSearchFindsPairsWithinEachLevelsEpipolarBand) {
   matches.clear();
   EXPECT_EQ(Matcher(0.8f, false).SearchForTriangulation(*kf1, *kf3, 0.0, matches), pairs - 1);
   for (const auto& [i, j] : matches) EXPECT_NE(i, 7u);
+}
+
+// With a helper thread scanning half of k1's keypoints, the search returns the same pairs in the
+// same order, ties included: k1's second half repeats keypoints of its first half (same pixel,
+// same descriptor), so every k2 keypoint is wanted by two k1 keypoints, one in each half, and the
+// lower index must win as in a scan in index order.
+TEST(MatcherTest, TriangulationSearchWithAHelperIsTheSameToTheBit) {
+  const Camera camera = testing_util::TestCamera();
+  auto pyramid = std::make_shared<ScalePyramid>(ScalePyramid::Make(8, 1.2f));
+  const Rigid3d cam2_from_world(Eigen::Translation3d(-1.0, 0.0, 0.0));
+  cv::RNG rng(5);
+  const int pairs = 250;
+  std::vector<cv::KeyPoint> kps1, kps2;
+  cv::Mat desc1(2 * pairs, 32, CV_8UC1), desc2(pairs, 32, CV_8UC1);
+  rng.fill(desc2, cv::RNG::UNIFORM, 0, 256);
+  for (int i = 0; i < pairs; ++i) {
+    const Eigen::Vector3d p(rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0), rng.uniform(3.0, 8.0));
+    const Eigen::Vector3d q = cam2_from_world * p;
+    kps1.emplace_back(cv::Point2f(585 * p.x() / p.z() + 320, 585 * p.y() / p.z() + 240), 31.f, 0.f,
+                      1.f, i % 4);
+    kps2.emplace_back(cv::Point2f(585 * q.x() / q.z() + 320, 585 * q.y() / q.z() + 240), 31.f, 0.f,
+                      1.f, i % 4);
+    desc2.row(i).copyTo(desc1.row(i));
+    // A few bits flipped in some of the copies: not every tie is exact.
+    desc2.row(i).copyTo(desc1.row(pairs + i));
+    if (i % 3 == 0) desc1.at<uchar>(pairs + i, i % 32) ^= 0x5;
+  }
+  for (int i = 0; i < pairs; ++i) kps1.push_back(kps1[static_cast<size_t>(i)]);
+  const auto features = [&](const std::vector<cv::KeyPoint>& kps, const cv::Mat& desc) {
+    return MakeFrameFeatures(camera, pyramid, 0.08, 3.2, kps, desc,
+                             std::vector<float>(kps.size(), -1.f), {}, true, true);
+  };
+  Map map;
+  Frame frame1(0, 0, 0.0, features(kps1, desc1)), frame2(1, 1, 0.1, features(kps2, desc2));
+  frame1.cam_from_world = Rigid3d::Identity();
+  frame2.cam_from_world = cam2_from_world;
+  const auto kf1 = map.CreateKeyFrame(frame1), kf2 = map.CreateKeyFrame(frame2);
+  const Matcher matcher(0.8f, false);
+  std::vector<std::pair<size_t, size_t>> alone, helped;
+  // Every k2 keypoint goes to the first-half keypoint: as near as its copy, or nearer.
+  const int n = matcher.SearchForTriangulation(*kf1, *kf2, 0.0, alone);
+  EXPECT_EQ(n, pairs);
+  for (const auto& [i, j] : alone) EXPECT_EQ(i, j);
+  WorkerPool helper(1);
+  EXPECT_EQ(matcher.SearchForTriangulation(*kf1, *kf2, 0.0, helped, &helper), n);
+  EXPECT_EQ(helped, alone);
 }
 
 }  // namespace

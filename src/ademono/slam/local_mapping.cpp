@@ -23,7 +23,10 @@ LocalMapping::LocalMapping(Map& map, const MappingOptions& options, bool monocul
       monocular_(monocular),
       configured_sigma_log_(configured_sigma_log) {
   options_.Check();
-  if (options_.threaded) worker_ = std::thread([this] { Run(); });
+  if (options_.threaded) {
+    worker_ = std::thread([this] { Run(); });
+    search_helper_.emplace(1);
+  }
 }
 
 LocalMapping::~LocalMapping() {
@@ -110,11 +113,11 @@ void LocalMapping::Solve(Pending& pending) const {
   pending.ms += MsSinceStart(start);
   spdlog::debug(
       "keyframe {}: BA {} cameras ({} fixed), {} points, {} observations: {:.1f} ms, cpu {:.1f} ms",
-                pending.keyframe->id, pending.problem.cameras.size(),
-                std::count_if(pending.problem.cameras.begin(), pending.problem.cameras.end(),
-                              [](const BaCamera& c) { return c.fixed; }),
-                pending.problem.points.size(), pending.problem.observations.size(),
-                MsSinceStart(start), ThreadCpuMs() - start_cpu);
+      pending.keyframe->id, pending.problem.cameras.size(),
+      std::count_if(pending.problem.cameras.begin(), pending.problem.cameras.end(),
+                    [](const BaCamera& c) { return c.fixed; }),
+      pending.problem.points.size(), pending.problem.observations.size(), MsSinceStart(start),
+      ThreadCpuMs() - start_cpu);
 }
 
 void LocalMapping::Merge() {
@@ -143,10 +146,11 @@ void LocalMapping::Merge() {
       loop_closing_->AssertMapHeld();  // the same map, under loop closing's name
       loop_closing_->Process(*pending->keyframe);
     }
-    spdlog::debug("keyframe {}: waited {:.1f} ms, apply + cull {:.1f} ms, loop {:.1f} ms, "
-                  "cpu {:.1f} ms",
-                  pending->keyframe->id, wait_ms, cull_ms, MsSinceStart(start) - cull_ms,
-                  ThreadCpuMs() - start_cpu);
+    spdlog::debug(
+        "keyframe {}: waited {:.1f} ms, apply + cull {:.1f} ms, loop {:.1f} ms, "
+        "cpu {:.1f} ms",
+        pending->keyframe->id, wait_ms, cull_ms, MsSinceStart(start) - cull_ms,
+        ThreadCpuMs() - start_cpu);
   }
   finished_ms_ += pending->ms + MsSinceStart(start);
 }
@@ -227,8 +231,8 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
   const PinholeIntrinsics& in = f1.intrinsics;
   const double min_parallax_cos =
       std::cos(options_.triangulation_min_parallax_deg * 3.14159265358979323846 / 180.0);
-  const float ratio_factor = 1.5f * f1.pyramid->scale_factors.at(std::min<size_t>(
-                                        1, f1.pyramid->scale_factors.size() - 1));
+  const float ratio_factor = 1.5f * f1.pyramid->scale_factors.at(
+                                        std::min<size_t>(1, f1.pyramid->scale_factors.size() - 1));
   const Eigen::Vector3d center1 = keyframe.CameraCenter();
   const Matcher matcher(static_cast<float>(options_.triangulation_match_ratio), false);
   int created = 0;
@@ -248,7 +252,8 @@ int LocalMapping::CreateNewMapPoints(KeyFrame& keyframe) {
       continue;
 
     std::vector<std::pair<size_t, size_t>> matches;
-    matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches);
+    matcher.SearchForTriangulation(keyframe, *k2, options_.triangulation_depth_sigmas, matches,
+                                   search_helper_ ? &*search_helper_ : nullptr);
     const FrameFeatures& f2 = k2->F();
     const Eigen::Vector3d center2 = k2->CameraCenter();
     for (const auto& [i1, i2] : matches) {
@@ -393,9 +398,8 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         fixed.size() > static_cast<size_t>(options_.ba_max_fixed_keyframes)) {
       // Most of the cost is the fixed keyframes' residuals: keep the ones that see the most
       // local points (ties: older first), which anchor the window as well as all of them.
-      std::stable_sort(fixed.begin(), fixed.end(), [&](KeyFrame* a, KeyFrame* b) {
-        return fixed_views[a] > fixed_views[b];
-      });
+      std::stable_sort(fixed.begin(), fixed.end(),
+                       [&](KeyFrame* a, KeyFrame* b) { return fixed_views[a] > fixed_views[b]; });
       fixed.resize(static_cast<size_t>(options_.ba_max_fixed_keyframes));
       std::sort(fixed.begin(), fixed.end(), KeyFrameIdLess());
     }
@@ -541,8 +545,8 @@ double LocalMapping::NetworkSigmaLog() const {
   // The recent keyframes' (the network's error depends on the scene it sees).
   constexpr size_t kRecent = 20;
   const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;
-  return Median(std::vector<double>(sigma_logs_.begin() + static_cast<long>(start),
-                                    sigma_logs_.end()));
+  return Median(
+      std::vector<double>(sigma_logs_.begin() + static_cast<long>(start), sigma_logs_.end()));
 }
 
 std::optional<double> LocalMapping::KeyFrameScaleSpread() const {

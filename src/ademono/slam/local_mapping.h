@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "ademono/core/worker_pool.h"
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/slam/loop_closing.h"
 #include "ademono/slam/map.h"
@@ -129,6 +130,9 @@ class LocalMapping {
   size_t frames_ = 0;       // HandOff calls so far, the current frame's included: the clock
   bool shut_down_ = false;
   std::thread worker_;
+  // Threaded: scans half of each triangulation search on the tracking thread's behalf (the
+  // mapping thread is busy with the last BA at most until the keyframe's first step merges it).
+  std::optional<WorkerPool> search_helper_;
 };
 
 }  // namespace ademono

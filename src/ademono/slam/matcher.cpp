@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <future>
 #include <opencv2/features2d.hpp>
 
 #include "ademono/core/geometry.h"
@@ -11,6 +12,10 @@
 
 namespace ademono {
 namespace {
+
+// Fewer keypoints than this are scanned on one thread: handing half to a helper costs a wake-up
+// (tens of microseconds), a scan of a few hundred keypoints about a tenth of a millisecond.
+constexpr size_t kMinKeypointsToSplit = 200;
 
 // The keypoint within `r` px of the prediction, on its level or the one below, whose descriptor is
 // nearest to `descriptor` (candidates for which `skip` is true left out), if it is within
@@ -303,8 +308,8 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
       // Localisation only: a loaded map's point always survives a fusion, and two of them are
       // never merged (the loaded map does not change).
       if (existing->frozen && point->frozen) continue;
-      if (existing->frozen || (!point->frozen &&
-                               existing->NumObservations() > point->NumObservations())) {
+      if (existing->frozen ||
+          (!point->frozen && existing->NumObservations() > point->NumObservations())) {
         map.ReplacePoint(point.get(), existing);
       } else {
         map.ReplacePoint(existing.get(), point);
@@ -319,7 +324,8 @@ int Matcher::Fuse(Map& map, KeyFrame& keyframe,
 }
 
 int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
-                                    std::vector<std::pair<size_t, size_t>>& matches) const {
+                                    std::vector<std::pair<size_t, size_t>>& matches,
+                                    WorkerPool* helper) const {
   const FrameFeatures& f1 = k1.F();
   const FrameFeatures& f2 = k2.F();
   const PinholeIntrinsics& in1 = f1.intrinsics;
@@ -363,58 +369,79 @@ int Matcher::SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, doub
   const std::vector<float>& level_sigma2 = f2.pyramid->level_sigma2;
   const double band_radius =
       std::sqrt(3.84 * *std::max_element(level_sigma2.begin(), level_sigma2.end()));
-  std::vector<size_t> near_line;
-  for (size_t i = 0; i < f1.Size(); ++i) {
-    if (k1.map_points[i] && !k1.map_points[i]->bad) continue;
-    const cv::KeyPoint& kp1 = f1.keypoints_un[i];
-    const Eigen::Vector3d x1(kp1.pt.x, kp1.pt.y, 1.0);
-    const Eigen::Vector3d line = F21 * x1;
-    const double line_norm2 = line.x() * line.x() + line.y() * line.y();
-    if (!(line_norm2 > 0)) continue;
-    // The depth prior bounds where on the line the match can be.
-    bool segment = false;
-    Eigen::Vector2d seg_a, seg_b;
-    if (depth_sigmas > 0 && f1.depth[i] > 0 && f1.DepthIsPrior()) {
-      const double z = f1.depth[i];
-      const double sigma = f1.depth_error.Sigma(z);
-      const double z_near = std::max(0.05, z - depth_sigmas * sigma);
-      const double z_far = z + depth_sigmas * sigma;
-      const Eigen::Vector3d ray = K1inv * x1;
-      segment = project2(cam2_from_cam1 * (z_near * ray), &seg_a) &&
-                project2(cam2_from_cam1 * (z_far * ray), &seg_b);
-    }
-    const uchar* d1 = f1.descriptors.ptr<uchar>(static_cast<int>(i));
+  // Each k1 keypoint's best and second-best candidate: independent of the others, so the keypoints
+  // can be scanned in two halves at once; who wins a k2 keypoint is settled after, in index order.
+  struct Best {
     int best = 256, second = 256;
     size_t best_j = 0;
-    grid2.Near(line, band_radius, &near_line);
-    for (size_t j : near_line) {
-      const cv::KeyPoint& kp2 = f2.keypoints_un[j];
-      const double e = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
-      const double sigma2 = f2.pyramid->level_sigma2[kp2.octave];
-      if (e * e / line_norm2 >= 3.84 * sigma2) continue;
-      if (has_epipole && f1.monocular && f2.monocular &&
-          (Eigen::Vector2d(kp2.pt.x, kp2.pt.y) - epipole).squaredNorm() <
-              100.0 * f2.pyramid->scale_factors[kp2.octave])
-        continue;
-      if (segment) {
-        const Eigen::Vector2d ab = seg_b - seg_a;
-        const double len2 = ab.squaredNorm();
-        const Eigen::Vector2d x2(kp2.pt.x, kp2.pt.y);
-        const double s = len2 > 0 ? (x2 - seg_a).dot(ab) / len2 : 0.0;
-        const double margin = 2.0 * std::sqrt(sigma2) / std::sqrt(std::max(len2, 1e-9));
-        if (s < -margin || s > 1.0 + margin) continue;
+  };
+  std::vector<Best> best_for1(f1.Size());
+  auto scan = [&](size_t begin, size_t end) {
+    std::vector<size_t> near_line;
+    for (size_t i = begin; i < end; ++i) {
+      if (k1.map_points[i] && !k1.map_points[i]->bad) continue;
+      const cv::KeyPoint& kp1 = f1.keypoints_un[i];
+      const Eigen::Vector3d x1(kp1.pt.x, kp1.pt.y, 1.0);
+      const Eigen::Vector3d line = F21 * x1;
+      const double line_norm2 = line.x() * line.x() + line.y() * line.y();
+      if (!(line_norm2 > 0)) continue;
+      // The depth prior bounds where on the line the match can be.
+      bool segment = false;
+      Eigen::Vector2d seg_a, seg_b;
+      if (depth_sigmas > 0 && f1.depth[i] > 0 && f1.DepthIsPrior()) {
+        const double z = f1.depth[i];
+        const double sigma = f1.depth_error.Sigma(z);
+        const double z_near = std::max(0.05, z - depth_sigmas * sigma);
+        const double z_far = z + depth_sigmas * sigma;
+        const Eigen::Vector3d ray = K1inv * x1;
+        segment = project2(cam2_from_cam1 * (z_near * ray), &seg_a) &&
+                  project2(cam2_from_cam1 * (z_far * ray), &seg_b);
       }
-      const int d = DescriptorDistance(d1, f2.descriptors.ptr<uchar>(static_cast<int>(j)));
-      if (d > kOrbDistanceLow) continue;
-      // Ties go to the lower index: the candidates come in no particular order.
-      if (d < best || (d == best && j < best_j)) {
-        second = best;
-        best = d;
-        best_j = j;
-      } else if (d < second) {
-        second = d;
+      const uchar* d1 = f1.descriptors.ptr<uchar>(static_cast<int>(i));
+      int best = 256, second = 256;
+      size_t best_j = 0;
+      grid2.Near(line, band_radius, &near_line);
+      for (size_t j : near_line) {
+        const cv::KeyPoint& kp2 = f2.keypoints_un[j];
+        const double e = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
+        const double sigma2 = f2.pyramid->level_sigma2[kp2.octave];
+        if (e * e / line_norm2 >= 3.84 * sigma2) continue;
+        if (has_epipole && f1.monocular && f2.monocular &&
+            (Eigen::Vector2d(kp2.pt.x, kp2.pt.y) - epipole).squaredNorm() <
+                100.0 * f2.pyramid->scale_factors[kp2.octave])
+          continue;
+        if (segment) {
+          const Eigen::Vector2d ab = seg_b - seg_a;
+          const double len2 = ab.squaredNorm();
+          const Eigen::Vector2d x2(kp2.pt.x, kp2.pt.y);
+          const double s = len2 > 0 ? (x2 - seg_a).dot(ab) / len2 : 0.0;
+          const double margin = 2.0 * std::sqrt(sigma2) / std::sqrt(std::max(len2, 1e-9));
+          if (s < -margin || s > 1.0 + margin) continue;
+        }
+        const int d = DescriptorDistance(d1, f2.descriptors.ptr<uchar>(static_cast<int>(j)));
+        if (d > kOrbDistanceLow) continue;
+        // Ties go to the lower index: the candidates come in no particular order.
+        if (d < best || (d == best && j < best_j)) {
+          second = best;
+          best = d;
+          best_j = j;
+        } else if (d < second) {
+          second = d;
+        }
       }
+      best_for1[i] = {best, second, best_j};
     }
+  };
+  const size_t n1 = f1.Size();
+  if (helper != nullptr && n1 >= kMinKeypointsToSplit) {
+    std::future<void> second_half = helper->Submit([&] { scan(n1 / 2, n1); });
+    scan(0, n1 / 2);
+    second_half.get();
+  } else {
+    scan(0, n1);
+  }
+  for (size_t i = 0; i < n1; ++i) {
+    const auto [best, second, best_j] = best_for1[i];
     if (best > kOrbDistanceLow || static_cast<float>(best) > nn_ratio_ * static_cast<float>(second))
       continue;
     if (best < dist_for2[best_j]) {
@@ -480,8 +507,8 @@ int Matcher::SearchForInitialization(const FrameFeatures& f1, const FrameFeature
   if (check_orientation_) {
     for (size_t i = 0; i < f1.Size(); ++i) {
       if (matches12[i] >= 0)
-        rotations.Add(f1.keypoints[i].angle,
-                      f2.keypoints[static_cast<size_t>(matches12[i])].angle, static_cast<int>(i));
+        rotations.Add(f1.keypoints[i].angle, f2.keypoints[static_cast<size_t>(matches12[i])].angle,
+                      static_cast<int>(i));
     }
     for (int i : rotations.InconsistentMatches()) matches12[static_cast<size_t>(i)] = -1;
   }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "ademono/core/worker_pool.h"
 #include "ademono/feature/matching.h"
 #include "ademono/slam/frame.h"
 #include "ademono/slam/keyframe.h"
@@ -57,9 +58,12 @@ class Matcher {
   // rotation check) among the candidates within the epipolar band of k2 (chi2 3.84 at the
   // candidate's level). A k1 keypoint with a depth prior only searches the part of its epipolar
   // line within `depth_sigmas` sigma of that depth (the whole line without one). Appends
-  // (k1 index, k2 index) pairs, each k2 keypoint at most once, and returns their number.
+  // (k1 index, k2 index) pairs, each k2 keypoint at most once, and returns their number. With a
+  // `helper`, its thread scans the second half of k1's keypoints while the caller scans the first;
+  // the matches are the same as without one, to the bit.
   int SearchForTriangulation(const KeyFrame& k1, const KeyFrame& k2, double depth_sigmas,
-                             std::vector<std::pair<size_t, size_t>>& matches) const;
+                             std::vector<std::pair<size_t, size_t>>& matches,
+                             WorkerPool* helper = nullptr) const;
 
   // Monocular initialisation (ORB-SLAM's SearchForInitialization): every keypoint of `f1` is
   // matched with the best keypoint of `f2` on the same pyramid level within `window` px (level 0)
@@ -68,8 +72,8 @@ class Matcher {
   // best f1 keypoint only, rotation consistency. `matches12[i]` is the f2 index or -1; matched
   // positions replace `prev_matched`. Returns the number of matches.
   int SearchForInitialization(const FrameFeatures& f1, const FrameFeatures& f2,
-                              std::vector<cv::Point2f>& prev_matched,
-                              std::vector<int>& matches12, float window) const;
+                              std::vector<cv::Point2f>& prev_matched, std::vector<int>& matches12,
+                              float window) const;
 
   static float RadiusByViewingCos(float view_cos) { return view_cos > 0.998f ? 2.5f : 4.0f; }
 
