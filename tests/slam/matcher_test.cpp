@@ -104,6 +104,28 @@ TEST(MatcherTest, RotationCheckDropsTheMatchThatTurnedAgainstTheOthers) {
   EXPECT_EQ(matches[5], nullptr);
 }
 
+// Keypoints without depth, as a monocular keyframe has them, for the triangulation search.
+std::shared_ptr<const FrameFeatures> SearchFeatures(const Camera& camera,
+                                                    std::shared_ptr<ScalePyramid> pyramid,
+                                                    const std::vector<cv::KeyPoint>& kps,
+                                                    const cv::Mat& desc) {
+  return MakeFrameFeatures(camera, std::move(pyramid), 0.08, 3.2, kps, desc,
+                           std::vector<float>(kps.size(), -1.f), {}, true, true);
+}
+
+// Two keyframes of `map` made of these keypoints: the first at the origin, the second at
+// `cam2_from_world`.
+std::pair<std::shared_ptr<KeyFrame>, std::shared_ptr<KeyFrame>> TwoKeyFrames(
+    Map& map, const Camera& camera, const std::shared_ptr<ScalePyramid>& pyramid,
+    const std::vector<cv::KeyPoint>& kps1, const cv::Mat& desc1,
+    const std::vector<cv::KeyPoint>& kps2, const cv::Mat& desc2, const Rigid3d& cam2_from_world) {
+  Frame frame1(0, 0, 0.0, SearchFeatures(camera, pyramid, kps1, desc1));
+  Frame frame2(1, 1, 0.1, SearchFeatures(camera, pyramid, kps2, desc2));
+  frame1.cam_from_world = Rigid3d::Identity();
+  frame2.cam_from_world = cam2_from_world;
+  return {map.CreateKeyFrame(frame1), map.CreateKeyFrame(frame2)};
+}
+
 // Triangulation's epipolar search (LineSearchGrid's band) finds every pair a keypoint off its
 // epipolar line by up to its pyramid level's tolerance, the top level's too, and no distractor.
 TEST(MatcherTest, TriangulationSearchFindsPairsWithinEachLevelsEpipolarBand) {
@@ -132,22 +154,16 @@ TEST(MatcherTest, TriangulationSearchFindsPairsWithinEachLevelsEpipolarBand) {
   for (int j = 0; j < distractors; ++j)
     kps2.emplace_back(cv::Point2f(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f)), 31.f, 0.f, 1.f,
                       j % 8);
-  const auto features = [&](const std::vector<cv::KeyPoint>& kps, const cv::Mat& desc) {
-    return MakeFrameFeatures(camera, pyramid, 0.08, 3.2, kps, desc,
-                             std::vector<float>(kps.size(), -1.f), {}, true, true);
-  };
   Map map;
-  Frame frame1(0, 0, 0.0, features(kps1, desc1)), frame2(1, 1, 0.1, features(kps2, desc2));
-  frame1.cam_from_world = Rigid3d::Identity();
-  frame2.cam_from_world = cam2_from_world;
-  const auto kf1 = map.CreateKeyFrame(frame1), kf2 = map.CreateKeyFrame(frame2);
+  const auto [kf1, kf2] =
+      TwoKeyFrames(map, camera, pyramid, kps1, desc1, kps2, desc2, cam2_from_world);
   std::vector<std::pair<size_t, size_t>> matches;
   EXPECT_EQ(Matcher(0.8f, false).SearchForTriangulation(*kf1, *kf2, 0.0, matches), pairs);
   for (const auto& [i, j] : matches) EXPECT_EQ(i, j);
 
   // A keypoint just outside its level's band is not matched.
   kps2[7].pt.y += 0.25f * std::sqrt(3.84f * pyramid->level_sigma2[7]);  // 1.15x the tolerance
-  Frame moved(2, 2, 0.2, features(kps2, desc2));
+  Frame moved(2, 2, 0.2, SearchFeatures(camera, pyramid, kps2, desc2));
   moved.cam_from_world = cam2_from_world;
   const auto kf3 = map.CreateKeyFrame(moved);
   matches.clear();
@@ -181,15 +197,9 @@ TEST(MatcherTest, TriangulationSearchWithAHelperIsTheSameToTheBit) {
     if (i % 3 == 0) desc1.at<uchar>(pairs + i, i % 32) ^= 0x5;
   }
   for (int i = 0; i < pairs; ++i) kps1.push_back(kps1[static_cast<size_t>(i)]);
-  const auto features = [&](const std::vector<cv::KeyPoint>& kps, const cv::Mat& desc) {
-    return MakeFrameFeatures(camera, pyramid, 0.08, 3.2, kps, desc,
-                             std::vector<float>(kps.size(), -1.f), {}, true, true);
-  };
   Map map;
-  Frame frame1(0, 0, 0.0, features(kps1, desc1)), frame2(1, 1, 0.1, features(kps2, desc2));
-  frame1.cam_from_world = Rigid3d::Identity();
-  frame2.cam_from_world = cam2_from_world;
-  const auto kf1 = map.CreateKeyFrame(frame1), kf2 = map.CreateKeyFrame(frame2);
+  const auto [kf1, kf2] =
+      TwoKeyFrames(map, camera, pyramid, kps1, desc1, kps2, desc2, cam2_from_world);
   const Matcher matcher(0.8f, false);
   std::vector<std::pair<size_t, size_t>> alone, helped;
   // Every k2 keypoint goes to the first-half keypoint: as near as its copy, or nearer.
