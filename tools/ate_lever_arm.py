@@ -8,9 +8,9 @@ ground truth: the same timestamps, world_from_cam) and prints, per run, the ATE 
 alignment (as `ademono eval`) and after a sim3 alignment plus a lever arm: a constant offset l in
 the ground truth's body frame, g_i = s A p_i + t + R_i l (R_i the ground truth's rotation),
 fitted by alternating Umeyama and linear least squares. A ground truth that tracks another point
-of the rig than the camera's centre (a depth camera, a marker body, KITTI's cam0 for image_2)
-leaves an error that turns with the camera, which no sim3 alignment removes. On an exact ground
-truth (the synthetic rows) the fitted offset is 0. Three free parameters always fit some noise:
+of the rig than the camera's centre (a depth camera, a marker body) leaves an error that turns
+with the camera, which no sim3 alignment removes. On an exact ground truth (the synthetic rows)
+the fitted offset is 0. Three free parameters always fit some noise:
 read the offset's size and whether it repeats across runs, not the smaller ATE alone.
 """
 import os

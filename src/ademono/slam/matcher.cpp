@@ -7,6 +7,7 @@
 #include <opencv2/features2d.hpp>
 
 #include "ademono/core/geometry.h"
+#include "ademono/core/worker_pool.h"
 #include "ademono/feature/line_search_grid.h"
 #include "ademono/feature/orb_extractor.h"
 

@@ -8,13 +8,14 @@
 #include <memory>
 #include <vector>
 
-#include "ademono/core/worker_pool.h"
 #include "ademono/feature/matching.h"
 #include "ademono/slam/frame.h"
 #include "ademono/slam/keyframe.h"
 #include "ademono/slam/map.h"
 
 namespace ademono {
+
+class WorkerPool;  // core/worker_pool.h
 
 class Matcher {
  public:
