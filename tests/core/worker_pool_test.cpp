@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include "ademono/core/thread_name.h"
 
 namespace ademono {
 namespace {
@@ -49,6 +53,36 @@ TEST(WorkerPoolTest, TheDestructorRunsWhatIsQueued) {
   }
   EXPECT_EQ(ran.load(), 50);
   EXPECT_THROW(WorkerPool(0), std::invalid_argument);
+}
+
+TEST(WorkerPoolTest, ItsThreadsCarryThePoolsNameAndIndex) {
+  std::set<std::string> names;
+  std::mutex names_mutex;
+  {
+    WorkerPool pool(2, "ademono-test");
+    std::vector<std::future<void>> done;
+    // Enough tasks that both threads take some (each waits a little).
+    for (int i = 0; i < 40; ++i) {
+      done.push_back(pool.Submit([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        std::lock_guard<std::mutex> lock(names_mutex);
+        names.insert(CurrentThreadName());
+      }));
+    }
+    for (auto& d : done) d.get();
+  }
+  for (const std::string& name : names)
+    EXPECT_TRUE(name == "ademono-test0" || name == "ademono-test1") << name;
+  EXPECT_FALSE(names.empty());
+}
+
+TEST(ThreadNameTest, ANameLongerThanTheKernelsLimitIsCutNotRefused) {
+  std::string seen;
+  std::thread([&] {
+    SetCurrentThreadName("ademono-a-very-long-thread-name");
+    seen = CurrentThreadName();
+  }).join();
+  EXPECT_EQ(seen, "ademono-a-very-");  // 15 characters
 }
 
 }  // namespace

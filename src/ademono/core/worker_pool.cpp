@@ -4,15 +4,22 @@
 #include <string>
 #include <utility>
 
+#include "ademono/core/thread_name.h"
+
 namespace ademono {
 
-WorkerPool::WorkerPool(int threads) {
+WorkerPool::WorkerPool(int threads, const std::string& name) {
   if (threads < 1) {
     throw std::invalid_argument("WorkerPool needs at least one thread, got " +
                                 std::to_string(threads));
   }
   threads_.reserve(threads);
-  for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Work(); });
+  for (int i = 0; i < threads; ++i) {
+    threads_.emplace_back([this, thread_name = name + std::to_string(i)] {
+      SetCurrentThreadName(thread_name);
+      Work();
+    });
+  }
 }
 
 WorkerPool::~WorkerPool() {

@@ -12,6 +12,7 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -20,7 +21,8 @@ namespace ademono {
 
 class WorkerPool {
  public:
-  explicit WorkerPool(int threads);
+  // Its threads are named `name` and their index ("ademono-prep0", ...: thread_name.h).
+  explicit WorkerPool(int threads, const std::string& name = "ademono-pool");
   // Runs the tasks still queued, then joins the threads.
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "ademono/core/error.h"
+#include "ademono/core/thread_name.h"
 #include "ademono/live/foxglove.h"
 #include "ademono/report/web_assets.h"
 
@@ -489,7 +490,10 @@ void LiveServer::Impl::Start() {
   endpoint = acceptor.local_endpoint();
   Accept();
   Tick();
-  thread = std::thread([self = shared_from_this()] { self->ioc.run(); });
+  thread = std::thread([self = shared_from_this()] {
+    SetCurrentThreadName("ademono-live");
+    self->ioc.run();
+  });
 }
 
 void LiveServer::Impl::Accept() {

@@ -107,8 +107,8 @@ PipelineResult RunPipeline(const Sequence& sequence, DepthProvider* depth, Detec
   // outlive the preparations waiting for them.
   std::optional<WorkerPool> helpers, preparers;
   if (result.prefetched) {
-    if (parallel_extraction) helpers.emplace(2 * static_cast<int>(depth_ahead));
-    preparers.emplace(static_cast<int>(depth_ahead));
+    if (parallel_extraction) helpers.emplace(2 * static_cast<int>(depth_ahead), "ademono-help");
+    preparers.emplace(static_cast<int>(depth_ahead), "ademono-prep");
   }
   WorkerPool* helper_pool = helpers ? &*helpers : nullptr;
   auto stop_requested = [&] {

@@ -4,13 +4,18 @@
 #include <chrono>
 #include <memory>
 
+#include "ademono/core/thread_name.h"
+
 namespace ademono {
 
 RealtimeFeed::RealtimeFeed(std::function<std::optional<FrameData>()> grab,
                            const RealtimeOptions& options)
     : grab_(std::move(grab)), options_(options) {
   options_.queue = std::max<size_t>(1, options_.queue);
-  thread_ = std::thread([this] { Capture(); });
+  thread_ = std::thread([this] {
+    SetCurrentThreadName("ademono-capture");
+    Capture();
+  });
 }
 
 RealtimeFeed::~RealtimeFeed() {

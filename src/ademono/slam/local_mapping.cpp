@@ -8,6 +8,7 @@
 #include <ctime>
 
 #include "ademono/core/statistics.h"
+#include "ademono/core/thread_name.h"
 #include "ademono/optimize/bundle_adjustment.h"
 #include "ademono/optimize/network_depth_model.h"
 #include "ademono/optimize/residuals.h"
@@ -24,8 +25,11 @@ LocalMapping::LocalMapping(Map& map, const MappingOptions& options, bool monocul
       configured_sigma_log_(configured_sigma_log) {
   options_.Check();
   if (options_.threaded) {
-    worker_ = std::thread([this] { Run(); });
-    search_helper_.emplace(1);
+    worker_ = std::thread([this] {
+      SetCurrentThreadName("ademono-mapping");
+      Run();
+    });
+    search_helper_.emplace(1, "ademono-search");
   }
 }
 

@@ -11,6 +11,7 @@
 #include <set>
 #include <thread>
 
+#include "ademono/core/thread_name.h"
 #include "ademono/core/timing.h"
 #include "ademono/feature/matching.h"
 #include "ademono/optimize/residuals.h"
@@ -407,6 +408,7 @@ void LoopClosing::StartGlobalBundleAdjustment(std::optional<size_t> event) {
   GlobalBa* raw = job.get();
   // Touches only the snapshot in *raw, never the map (single-threaded Ceres: deterministic).
   job->worker = std::thread([raw, ba] {
+    SetCurrentThreadName("ademono-globalba");
     const auto start = std::chrono::steady_clock::now();
     try {
       raw->result = SolveBundleAdjustment(raw->problem, ba);
