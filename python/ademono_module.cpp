@@ -618,6 +618,11 @@ PYBIND11_MODULE(ademono, m) {
           "Before the first frame: start from a saved map (relocalise in it; localize_only: "
           "never change it)")
       .def(
+          "loaded_map_has_metric_scale",
+          [](PySystem& s) { return s.Get().LoadedMapHasMetricScale(); },
+          "False after load_map of a map built without depth (--depth none): track it without "
+          "depth")
+      .def(
           "trajectory", [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
           "(timestamps (N,), world_from_cam (N, 4, 4)) of the tracked frames")
       .def(

@@ -246,6 +246,7 @@ def test_save_map_then_localize_only_leaves_the_file(tmp_path):
     saved = (tmp_path / "a.map").read_bytes()
     second = ademono.System(config, seq.camera)
     second.load_map(tmp_path / "a.map", localize_only=True)
+    assert second.loaded_map_has_metric_scale()  # built with sensor depth
     states = [second.track(seq[i].image, depth=seq[i].depth, timestamp=seq[i].timestamp).state
               for i in range(40, 50)]
     assert states == ["ok"] * 10

@@ -74,7 +74,41 @@ TEST_F(MapCliTest, MapInfoPrintsWhatTheMapHolds) {
   EXPECT_NE(r.out.find("camera: 640x480 fx 585"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("keyframes: "), std::string::npos);
   EXPECT_NE(r.out.find("map points: "), std::string::npos);
-  EXPECT_NE(r.out.find("bounding box"), std::string::npos);
+  EXPECT_NE(r.out.find("bounding box (m)"), std::string::npos);
+  EXPECT_NE(r.out.find("scale: metric"), std::string::npos) << r.out;
+}
+
+// A map built with --depth none is in the units of its two-view start: `map info` says so, and a
+// run with depth refuses it before its first frame (one line naming the file, exit 2, nothing
+// written); a run without depth uses it.
+TEST_F(MapCliTest, AMapWithoutMetricScaleIsRefusedWithDepth) {
+  const fs::path none_map = *dir_ / "none.map";
+  const CliResult built = RunCli("run --dataset " + Dataset() + " --depth none --frames 0:90" +
+                                 " --save-map " + none_map.string() + " --out " +
+                                 (*dir_ / "none_first").string());
+  ASSERT_EQ(built.code, 0) << built.out;
+  const CliResult info = RunCli("map info " + none_map.string());
+  ASSERT_EQ(info.code, 0) << info.out;
+  EXPECT_NE(info.out.find("scale: arbitrary (built with --depth none"), std::string::npos)
+      << info.out;
+  EXPECT_NE(info.out.find("bounding box (map units)"), std::string::npos) << info.out;
+
+  const fs::path out = *dir_ / "none_with_depth";
+  const CliResult r = RunCli("run --dataset " + Dataset() + " --config " + Config() +
+                             " --frames 60:70 --load-map " + none_map.string() + " --out " +
+                             out.string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find(none_map.string() + ": the map has no metric scale"), std::string::npos)
+      << r.out;
+  EXPECT_FALSE(fs::exists(out)) << "partial output";
+
+  const fs::path geometric = *dir_ / "none_without_depth";
+  const CliResult g = RunCli("run --dataset " + Dataset() + " --depth none --frames 60:90" +
+                             " --load-map " + none_map.string() + " --localize-only --out " +
+                             geometric.string());
+  ASSERT_EQ(g.code, 0) << g.out;
+  const auto summary = nlohmann::json::parse(ReadFile(geometric / "summary.json"));
+  EXPECT_GE(summary["tracked"].get<int>(), 25) << g.out;
 }
 
 TEST_F(MapCliTest, BadMapsExitTwoWithOneLineNamingTheFile) {

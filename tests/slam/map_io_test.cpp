@@ -375,6 +375,14 @@ TEST_F(MapIoTest, SummaryCountsWhatTheMapHolds) {
             std::string::npos);
   EXPECT_NE(text.find("keyframes: " + std::to_string(keyframes_)), std::string::npos);
   EXPECT_NE(text.find("tracking:"), std::string::npos);  // the options
+  // Built with sensor depth: metres.
+  EXPECT_TRUE(MapHasMetricScale(data));
+  EXPECT_TRUE(s.metric_scale);
+  EXPECT_NE(text.find("scale: metric"), std::string::npos);
+  EXPECT_NE(text.find("bounding box (m)"), std::string::npos);
+  System system(Slice(0, 1)->GetCamera(), TestOptions());
+  system.LoadMap(MapPath(), true);
+  EXPECT_TRUE(system.LoadedMapHasMetricScale());
 }
 
 }  // namespace

@@ -6,12 +6,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
 
+#include "ademono/core/error.h"
 #include "ademono/depth/simulated_depth.h"
 #include "ademono/eval/trajectory_eval.h"
+#include "ademono/slam/map_io.h"
 #include "ademono/slam/system.h"
 #include "ademono/synth/generator.h"
 #include "ademono/synth/scenes.h"
@@ -276,6 +279,69 @@ TEST(MonocularTest, TheNetworksScaleHoldsEachKeyFramesScale) {
 // rest of the run would track against that one keyframe. Here a covered lens outlasts the weak
 // poses, and the frames after it are the office mirrored, a place the map has never seen (ORB
 // descriptors are not mirror-invariant; depth and motion mirror with the image).
+// A map built without depth has the scale of its two-view start, not metres: it says so, and
+// loading it into a run with depth (whose residuals are in metres) is refused at the first frame
+// with depth, naming the file; without depth it is tracked as usual.
+TEST(MonocularTest, AMapBuiltWithoutDepthHasNoMetricScaleAndRefusesDepth) {
+  const size_t frames = 150;  // the two-view start waits up to 70 % of them for parallax
+  const synth::SceneOptions scene_options = Office(frames);
+  const synth::Scene scene = synth::BuildScene(scene_options);
+  synth::GeneratorOptions generator;
+  generator.scene = scene_options;
+  auto frame_at = [&](size_t k, cv::Mat* depth) {
+    const synth::RenderedFrame rendered = synth::RenderSceneFrame(scene, k, generator);
+    FrameData frame;
+    frame.index = k;
+    frame.timestamp = scene.TimeOf(k);
+    frame.image = rendered.image;
+    if (depth != nullptr) *depth = rendered.depth;
+    return frame;
+  };
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("ademono_scale_free_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / "none.map";
+  {
+    System system(scene.camera, Options(DepthInput::kNone));
+    int tracked = 0;
+    for (size_t k = 0; k < frames; ++k)
+      tracked += system.TrackFrame(frame_at(k, nullptr), {}, {}).tracked;
+    ASSERT_GT(tracked, 40);
+    system.SaveMap(path);
+  }
+  const MapFileData data = LoadMapFile(path);
+  ASSERT_FALSE(data.keyframes.empty());
+  EXPECT_FALSE(MapHasMetricScale(data));
+  const std::string text = MapSummaryText(path, SummarizeMap(data, 0));
+  EXPECT_NE(text.find("scale: arbitrary (built with --depth none"), std::string::npos) << text;
+  EXPECT_NE(text.find("bounding box (map units)"), std::string::npos);
+
+  {
+    System with_depth(scene.camera, Options(DepthInput::kExact));
+    with_depth.LoadMap(path, true);
+    EXPECT_FALSE(with_depth.LoadedMapHasMetricScale());
+    cv::Mat depth;
+    const FrameData frame = frame_at(120, &depth);
+    try {
+      with_depth.TrackFrame(frame, depth, {});
+      ADD_FAILURE() << "tracked depth against a map without metric scale";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path.string() + ": the map has no metric scale", 0), 0u) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+  }
+  {
+    System without_depth(scene.camera, Options(DepthInput::kNone));
+    without_depth.LoadMap(path, true);
+    int tracked = 0;
+    for (size_t k = 110; k < 130; ++k)
+      tracked += without_depth.TrackFrame(frame_at(k, nullptr), {}, {}).tracked;
+    EXPECT_GT(tracked, 15);  // relocalised in the loaded map and tracked on it
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(MonocularTest, TheMapGrowsAgainAfterARestart) {
   const SimulatedDepthOptions network = testing_util::FastDepthLikeNetwork(60, 3);
   const size_t frames = 260, gap_begin = 60, gap_end = 110;

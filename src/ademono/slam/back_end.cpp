@@ -72,6 +72,11 @@ std::string CameraText(const Camera& c) {
 
 }  // namespace
 
+std::string ScaleFreeMapProblem() {
+  return "the map has no metric scale (it was built with --depth none); load it with --depth "
+         "none, or build it with depth";
+}
+
 void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
                       const std::shared_ptr<const ScalePyramid>& pyramid) {
   const MapFileData data = LoadMapFile(path);
@@ -82,6 +87,7 @@ void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
   MutexLock lock(map_.mutex);
   if (map_.NumKeyFrames() != 0) throw std::logic_error("BackEnd::LoadMap: the map is not empty");
   RestoreMap(data, pyramid, map_, path);
+  if (!MapHasMetricScale(data)) scale_free_map_ = path;
   if (localize_only) {
     // Mapping may add temporary keyframes and points beside the loaded ones (tracking's
     // temporary_map) but never changes these; a loop correction would move them, so none.
@@ -149,6 +155,8 @@ int BackEnd::CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::
 
 BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
                              const FilteredFrame& filtered) {
+  // Depth in metres against a map in arbitrary units: every depth residual would pull the pose.
+  if (!scale_free_map_.empty() && !depth.empty()) ThrowInputError(scale_free_map_, ScaleFreeMapProblem());
   BackEndResult result;
   const auto start = std::chrono::steady_clock::now();
   TrackingOutput& out = result.tracking;

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "ademono/core/camera.h"
@@ -24,6 +25,10 @@
 #include "ademono/slam/tracking.h"
 
 namespace ademono {
+
+// Why a map without metric scale cannot be extended or localised in with depth: the message of
+// the InputError that names its file.
+std::string ScaleFreeMapProblem();
 
 // Which frame poses a trajectory holds (BackEnd::FrameTrajectory).
 enum class FramePoses { kWritten, kResolved };
@@ -68,8 +73,13 @@ class BackEnd {
   // points are frozen; tracking.temporary_map may add temporary ones beside them, which are never
   // saved) and no loop is closed. SaveMap finishes local mapping (Shutdown) and writes the map
   // atomically (after localisation only: the loaded map as it was read).
+  // A map without metric scale (built with --depth none, MapHasMetricScale) is tracked only
+  // without depth: a frame with depth (sensor or network) then throws InputError naming the map,
+  // as the runner does before its first frame (ScaleFreeMapProblem).
   void LoadMap(const std::filesystem::path& path, bool localize_only,
                const std::shared_ptr<const ScalePyramid>& pyramid);
+  // False after LoadMap of a map without metric scale; true otherwise.
+  bool LoadedMapHasMetricScale() const { return scale_free_map_.empty(); }
   void SaveMap(const std::filesystem::path& path);
   // Place recognition index of the live keyframes (thread-safe on its own).
   const KeyFrameDatabase& GetKeyFrameDatabase() const { return keyframe_database_; }
@@ -116,6 +126,8 @@ class BackEnd {
   std::map<uint64_t, cv::Vec3b> point_colors_;
   // Localisation only: the map as loaded, what SaveMap writes (temporary keyframes never are).
   std::optional<MapFileData> loaded_map_;
+  // The loaded map's file when it has no metric scale (empty otherwise).
+  std::filesystem::path scale_free_map_;
   bool shut_down_ = false;
 };
 

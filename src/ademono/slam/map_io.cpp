@@ -404,8 +404,16 @@ void SaveMapFile(const std::filesystem::path& path, const MapFileData& data) {
   }
 }
 
+bool MapHasMetricScale(const MapFileData& data) {
+  for (const MapKeyFrameRecord& kf : data.keyframes)
+    for (float z : kf.depth)
+      if (z > 0) return true;
+  return false;
+}
+
 MapFileSummary SummarizeMap(const MapFileData& data, uint64_t file_size) {
   MapFileSummary s;
+  s.metric_scale = MapHasMetricScale(data);
   s.version = data.version;
   s.file_size = file_size;
   s.camera = data.camera;
@@ -438,7 +446,12 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
   o << "map points: " << s.num_points << " (" << s.num_points_not_admitted
     << " not admitted: awaiting a confirming view or judged moving)\n";
   o << "observations: " << s.num_observations << "\n";
-  o << "bounding box (m): min [" << s.min_corner.x() << ", " << s.min_corner.y() << ", "
+  o << "scale: "
+    << (s.metric_scale ? "metric (built with sensor or network depth)"
+                       : "arbitrary (built with --depth none: geometry alone, in units of its "
+                         "two-view start)")
+    << "\n";
+  o << "bounding box (" << (s.metric_scale ? "m" : "map units") << "): min [" << s.min_corner.x() << ", " << s.min_corner.y() << ", "
     << s.min_corner.z() << "] max [" << s.max_corner.x() << ", " << s.max_corner.y() << ", "
     << s.max_corner.z() << "]\n";
   o << "options:\n";

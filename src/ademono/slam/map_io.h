@@ -78,6 +78,10 @@ struct MapFileData {
   std::vector<MapPointRecord> points;        // live points, by id
 };
 
+// Whether the map has a metric scale: some keyframe has a depth (sensor or network depth built
+// it). A map built with --depth none has none: geometry alone, at the scale of its two-view start.
+bool MapHasMetricScale(const MapFileData& data);
+
 // What `ademono map info` prints.
 struct MapFileSummary {
   uint32_t version = 0;
@@ -85,6 +89,7 @@ struct MapFileSummary {
   Camera camera;
   size_t num_keyframes = 0, num_points = 0, num_observations = 0;
   size_t num_points_not_admitted = 0;  // awaiting a confirming view, or judged moving
+  bool metric_scale = true;             // MapHasMetricScale
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero(), max_corner = Eigen::Vector3d::Zero();
   std::string options_yaml;
 };

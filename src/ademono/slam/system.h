@@ -90,6 +90,8 @@ class System {
     back_end_.LoadMap(path, localize_only, front_end_.Pyramid());
   }
   void SaveMap(const std::filesystem::path& path) { back_end_.SaveMap(path); }
+  // False after loading a map built with --depth none (BackEnd::LoadMap).
+  bool LoadedMapHasMetricScale() const { return back_end_.LoadedMapHasMetricScale(); }
 
   // Pose of every tracked input frame, resolved against the current keyframe poses (and, as
   // written, smoothed where tracking.smooth_trajectory is on).
