@@ -377,12 +377,35 @@ TEST_F(MapIoTest, SummaryCountsWhatTheMapHolds) {
   EXPECT_NE(text.find("tracking:"), std::string::npos);  // the options
   // Built with sensor depth: metres.
   EXPECT_TRUE(MapHasMetricScale(data));
-  EXPECT_TRUE(s.metric_scale);
+  EXPECT_EQ(s.scale, MapScale::kDepth);
   EXPECT_NE(text.find("scale: metric"), std::string::npos);
   EXPECT_NE(text.find("bounding box (m)"), std::string::npos);
   System system(Slice(0, 1)->GetCamera(), TestOptions());
   system.LoadMap(MapPath(), true);
   EXPECT_TRUE(system.LoadedMapHasMetricScale());
+}
+
+// Without keyframe depth (--depth none) a map is metric only where its run held the road at the
+// rig's camera height (outdoors); its options say so. Options that do not parse say nothing.
+TEST_F(MapIoTest, AMapWithoutDepthIsMetricOnlyWithACameraHeight) {
+  MapFileData data = LoadMapFile(MapPath());
+  for (MapKeyFrameRecord& kf : data.keyframes) std::fill(kf.depth.begin(), kf.depth.end(), -1.0f);
+  data.options_yaml = "depth:\n  camera_height: 1.65\n  min_depth: 1\n";
+  EXPECT_EQ(MapScaleOf(data), MapScale::kRoad);
+  EXPECT_DOUBLE_EQ(MapCameraHeight(data), 1.65);
+  EXPECT_TRUE(MapHasMetricScale(data));
+  const std::string road = MapSummaryText("x.map", SummarizeMap(data, 0));
+  EXPECT_NE(road.find("scale: metric (the road held at the camera height, 1.65 m)"),
+            std::string::npos)
+      << road;
+  EXPECT_NE(road.find("bounding box (m)"), std::string::npos);
+  for (const std::string& options :
+       {std::string("depth:\n  camera_height: 0\n"), std::string("tracking: {}\n"),
+        std::string("depth: [1, 2\n"), std::string("depth: 3\n"), std::string("")}) {
+    data.options_yaml = options;
+    EXPECT_EQ(MapScaleOf(data), MapScale::kArbitrary) << options;
+    EXPECT_FALSE(MapHasMetricScale(data)) << options;
+  }
 }
 
 }  // namespace

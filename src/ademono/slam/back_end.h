@@ -73,7 +73,7 @@ class BackEnd {
   // points are frozen; tracking.temporary_map may add temporary ones beside them, which are never
   // saved) and no loop is closed. SaveMap finishes local mapping (Shutdown) and writes the map
   // atomically (after localisation only: the loaded map as it was read).
-  // A map without metric scale (built with --depth none, MapHasMetricScale) is tracked only
+  // A map without metric scale (--depth none without a camera height: MapScaleOf) is tracked only
   // without depth: a frame with depth (sensor or network) then throws InputError naming the map,
   // as the runner does before its first frame (ScaleFreeMapProblem).
   void LoadMap(const std::filesystem::path& path, bool localize_only,

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 #include <zlib.h>
 
 #include <cereal/archives/portable_binary.hpp>
@@ -404,16 +405,28 @@ void SaveMapFile(const std::filesystem::path& path, const MapFileData& data) {
   }
 }
 
-bool MapHasMetricScale(const MapFileData& data) {
+double MapCameraHeight(const MapFileData& data) {
+  try {
+    const YAML::Node options = YAML::Load(data.options_yaml);
+    if (!options.IsMap() || !options["depth"].IsMap()) return 0.0;
+    const YAML::Node height = options["depth"]["camera_height"];
+    return height.IsScalar() ? std::max(0.0, height.as<double>()) : 0.0;
+  } catch (const YAML::Exception&) {
+    return 0.0;  // a file's options are informative only: unreadable ones say nothing
+  }
+}
+
+MapScale MapScaleOf(const MapFileData& data) {
   for (const MapKeyFrameRecord& kf : data.keyframes)
     for (float z : kf.depth)
-      if (z > 0) return true;
-  return false;
+      if (z > 0) return MapScale::kDepth;
+  return MapCameraHeight(data) > 0 ? MapScale::kRoad : MapScale::kArbitrary;
 }
 
 MapFileSummary SummarizeMap(const MapFileData& data, uint64_t file_size) {
   MapFileSummary s;
-  s.metric_scale = MapHasMetricScale(data);
+  s.scale = MapScaleOf(data);
+  s.camera_height = MapCameraHeight(data);
   s.version = data.version;
   s.file_size = file_size;
   s.camera = data.camera;
@@ -446,13 +459,18 @@ std::string MapSummaryText(const std::filesystem::path& path, const MapFileSumma
   o << "map points: " << s.num_points << " (" << s.num_points_not_admitted
     << " not admitted: awaiting a confirming view or judged moving)\n";
   o << "observations: " << s.num_observations << "\n";
-  o << "scale: "
-    << (s.metric_scale ? "metric (built with sensor or network depth)"
-                       : "arbitrary (built with --depth none: geometry alone, in units of its "
-                         "two-view start)")
-    << "\n";
-  o << "bounding box (" << (s.metric_scale ? "m" : "map units") << "): min [" << s.min_corner.x() << ", " << s.min_corner.y() << ", "
-    << s.min_corner.z() << "] max [" << s.max_corner.x() << ", " << s.max_corner.y() << ", "
+  const bool metric = s.scale != MapScale::kArbitrary;
+  o << "scale: ";
+  if (s.scale == MapScale::kDepth) {
+    o << "metric (built with sensor or network depth)";
+  } else if (s.scale == MapScale::kRoad) {
+    o << "metric (the road held at the camera height, " << s.camera_height << " m)";
+  } else {
+    o << "arbitrary (built with --depth none: geometry alone, in units of its two-view start)";
+  }
+  o << "\n";
+  o << "bounding box (" << (metric ? "m" : "map units") << "): min [" << s.min_corner.x() << ", "
+    << s.min_corner.y() << ", " << s.min_corner.z() << "] max [" << s.max_corner.x() << ", " << s.max_corner.y() << ", "
     << s.max_corner.z() << "]\n";
   o << "options:\n";
   std::istringstream lines(s.options_yaml);

@@ -78,9 +78,16 @@ struct MapFileData {
   std::vector<MapPointRecord> points;        // live points, by id
 };
 
-// Whether the map has a metric scale: some keyframe has a depth (sensor or network depth built
-// it). A map built with --depth none has none: geometry alone, at the scale of its two-view start.
-bool MapHasMetricScale(const MapFileData& data);
+// Where the map's scale comes from: keyframe depths (sensor or network depth built it), the road
+// held at the rig's camera height (depth.camera_height in its options: --depth none outdoors), or
+// nothing (--depth none without a camera height: the units of its two-view start).
+enum class MapScale { kDepth, kRoad, kArbitrary };
+MapScale MapScaleOf(const MapFileData& data);
+// The depth.camera_height of the run that built the map (0: none, or options it cannot read).
+double MapCameraHeight(const MapFileData& data);
+inline bool MapHasMetricScale(const MapFileData& data) {
+  return MapScaleOf(data) != MapScale::kArbitrary;
+}
 
 // What `ademono map info` prints.
 struct MapFileSummary {
@@ -89,7 +96,8 @@ struct MapFileSummary {
   Camera camera;
   size_t num_keyframes = 0, num_points = 0, num_observations = 0;
   size_t num_points_not_admitted = 0;  // awaiting a confirming view, or judged moving
-  bool metric_scale = true;             // MapHasMetricScale
+  MapScale scale = MapScale::kDepth;    // MapScaleOf
+  double camera_height = 0;             // MapCameraHeight
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero(), max_corner = Eigen::Vector3d::Zero();
   std::string options_yaml;
 };
