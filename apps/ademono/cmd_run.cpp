@@ -266,8 +266,12 @@ int Run(const RunArgs& args) {
             << " map points; tracking median " << std::fixed << std::setprecision(1)
             << report.timing.at("tracking").median_ms << " ms/frame\n";
   if (report.accuracy) {
+    // Without depth or a camera height the map's unit is its two-view start's: se3 then scores
+    // that unit, not the trajectory's shape.
+    const bool scale_free = report.depth == "none" && !(report.options.depth.camera_height > 0);
     std::cout << "ATE se3 " << std::setprecision(4) << report.accuracy->ate_se3_rmse_m
-              << " m, sim3 " << report.accuracy->ate_sim3_rmse_m << " m\n";
+              << " m, sim3 " << report.accuracy->ate_sim3_rmse_m << " m"
+              << (scale_free ? " (no metric scale without depth: read sim3)" : "") << "\n";
   }
   if (report.Tracked() < report.frames) {
     std::cout << (report.frames - report.Tracked()) << " frames untracked (no pose written)\n";

@@ -63,8 +63,12 @@ TEST_F(GeometricCliTest, GeometryAloneIsWithinOneAndAHalfTimesSensorDepthOnTheOf
   r = Run("run" + common + " --config " + ADEMONO_SOURCE_DIR +
           "/configs/network_indoor.yaml --depth none --out " + none.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // se3 scores the two-view start's unit without depth: the run says which figure to read.
+  EXPECT_NE(r.out.find(" m (no metric scale without depth: read sim3)\n"), std::string::npos)
+      << r.out;
   r = Run("run" + common + " --depth sensor --out " + sensor.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("no metric scale"), std::string::npos) << r.out;
 
   // The two-view start waits for parallax; from there on every frame is tracked.
   const std::set<std::string> tracked = Stamps(ReadFile(none / "trajectory.tum"));
