@@ -620,8 +620,8 @@ PYBIND11_MODULE(ademono, m) {
       .def(
           "loaded_map_has_metric_scale",
           [](PySystem& s) { return s.Get().LoadedMapHasMetricScale(); },
-          "False after load_map of a map built without depth (--depth none): track it without "
-          "depth")
+          "False after load_map of a map built without depth (--depth none) and without a "
+          "camera height: track it without depth")
       .def(
           "trajectory", [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
           "(timestamps (N,), world_from_cam (N, 4, 4)) of the tracked frames")

@@ -73,8 +73,8 @@ std::string CameraText(const Camera& c) {
 }  // namespace
 
 std::string ScaleFreeMapProblem() {
-  return "the map has no metric scale (it was built with --depth none); load it with --depth "
-         "none, or build it with depth";
+  return "the map has no metric scale (it was built with --depth none and no camera height); "
+         "load it with --depth none, or build it with depth";
 }
 
 void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
@@ -156,7 +156,8 @@ int BackEnd::CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::
 BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
                              const FilteredFrame& filtered) {
   // Depth in metres against a map in arbitrary units: every depth residual would pull the pose.
-  if (!scale_free_map_.empty() && !depth.empty()) ThrowInputError(scale_free_map_, ScaleFreeMapProblem());
+  if (!scale_free_map_.empty() && !depth.empty())
+    ThrowInputError(scale_free_map_, ScaleFreeMapProblem());
   BackEndResult result;
   const auto start = std::chrono::steady_clock::now();
   TrackingOutput& out = result.tracking;

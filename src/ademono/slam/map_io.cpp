@@ -8,6 +8,7 @@
 #include <cereal/archives/portable_binary.hpp>
 #include <cereal/types/array.hpp>
 #include <cereal/types/utility.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
