@@ -17,14 +17,17 @@ struct ReportArgs {
   std::vector<std::string> runs;
   std::vector<std::string> names;
   std::string out;
-  std::string align = "se3";
+  std::string align = "auto";
   int max_map_points = ademono::ReportOptions().max_map_points;
 };
 
 int RunReport(const ReportArgs& a) {
   using namespace ademono;
   ReportOptions options;
-  options.alignment = ParseAlignment(a.align);
+  if (a.align != "auto") {
+    options.alignment = ParseAlignment(a.align);
+    options.sim3_without_metric_scale = false;
+  }
   options.max_map_points = a.max_map_points;
   try {
     options.Check();
@@ -55,8 +58,10 @@ const bool kRegistered = ademono::cli::RegisterCommand(
                      "Output HTML (default: RUN_DIR/report.html; for several runs, report.html "
                      "next to the first)");
       app.add_option("--name", args->names, "Label per run folder (repeat; default: folder names)");
-      app.add_option("--align", args->align, "Alignment of each estimate to its ground truth")
-          ->check(CLI::IsMember({"none", "se3", "sim3", "origin"}))
+      app.add_option("--align", args->align,
+                     "Alignment of each estimate to its ground truth (auto: se3, or sim3 for a "
+                     "run without metric scale: --depth none without a camera height)")
+          ->check(CLI::IsMember({"auto", "none", "se3", "sim3", "origin"}))
           ->capture_default_str();
       app.add_option("--max-map-points", args->max_map_points,
                      "Map points embedded in the 3D view (evenly subsampled beyond)")

@@ -176,6 +176,35 @@ TEST_F(ReportTest, AlignsTheEstimateOntoTheGroundTruthWithTheEvalModule) {
   EXPECT_EQ(data["map"]["count"], 1000);
 }
 
+// A run without depth has no metric scale: its report aligns with sim3 (se3 would score the
+// unit of its two-view start) unless an alignment is asked for; a camera height gives it metres.
+TEST_F(ReportTest, ARunWithoutMetricScaleIsAlignedWithSim3) {
+  WriteRunFolder(root_ / "run", {.bump = 0.0});
+  json summary = json::parse(ReadTextFile(root_ / "run" / "summary.json"));
+  EXPECT_TRUE(RunHasMetricScale(ReadRunFolder(root_ / "run")));  // simulated depth
+  summary["depth"] = "none";
+  WriteTextFileAtomic(root_ / "run" / "summary.json", summary.dump());
+  const RunFolder none = ReadRunFolder(root_ / "run");
+  EXPECT_FALSE(RunHasMetricScale(none));
+  const json data = RunReportData(none, ReportOptions());
+  EXPECT_EQ(data["alignment"], "sim3");
+  EXPECT_NE(data.value("alignment_reason", std::string()).find("no metric scale"),
+            std::string::npos);
+  ReportOptions asked;
+  asked.sim3_without_metric_scale = false;  // `ademono report --align se3`
+  EXPECT_EQ(RunReportData(none, asked)["alignment"], "se3");
+  EXPECT_FALSE(RunReportData(none, asked).contains("alignment_reason"));
+  asked.alignment = Alignment::kOrigin;
+  asked.sim3_without_metric_scale = true;  // only se3 is replaced
+  EXPECT_EQ(RunAlignment(none, asked), Alignment::kOrigin);
+
+  summary["ground_scale"] = {{"camera_height", 1.65}, {"estimates", 3}};
+  WriteTextFileAtomic(root_ / "run" / "summary.json", summary.dump());
+  const RunFolder road = ReadRunFolder(root_ / "run");
+  EXPECT_TRUE(RunHasMetricScale(road));
+  EXPECT_EQ(RunReportData(road, ReportOptions())["alignment"], "se3");
+}
+
 TEST_F(ReportTest, ChoosesThumbnailsAtWorstErrorRelocalisationAndMostDynamicRemovals) {
   WriteRunFolder(root_ / "run");
   ReportOptions options;
@@ -423,6 +452,9 @@ TEST(ReportOptionsTest, FromYamlIsStrict) {
   const ReportOptions o =
       ReportOptions::FromYaml(YAML::Load("{alignment: sim3, max_map_points: 5}"));
   EXPECT_EQ(o.alignment, Alignment::kSim3);
+  EXPECT_FALSE(o.sim3_without_metric_scale);  // an alignment asked for is kept
+  EXPECT_TRUE(
+      ReportOptions::FromYaml(YAML::Load("{max_map_points: 5}")).sim3_without_metric_scale);
   EXPECT_EQ(o.max_map_points, 5);
   EXPECT_THROW(ReportOptions::FromYaml(YAML::Load("{max_points: 5}")), std::invalid_argument);
   EXPECT_THROW(ReportOptions::FromYaml(YAML::Load("{alignment: affine}")), std::invalid_argument);

@@ -573,6 +573,7 @@ ReportOptions ReportOptions::FromYaml(const YAML::Node& node) {
   CheckYamlKeys(node, "report",
                 {"alignment", "max_map_points", "max_thumbnails", "thumbnail_width",
                  "thumbnail_jpeg_quality"});
+  if (node.IsMap() && node["alignment"]) o.sim3_without_metric_scale = false;  // asked for
   o.alignment = ReadYamlChoice<Alignment>(node, "report", "alignment",
                                           {{"none", Alignment::kNone},
                                            {"se3", Alignment::kSe3},
@@ -727,16 +728,33 @@ RunFolder ReadRunFolder(const fs::path& dir) {
   return run;
 }
 
+bool RunHasMetricScale(const RunFolder& run) {
+  if (run.summary.value("depth", std::string()) != "none") return true;
+  const auto ground = run.summary.find("ground_scale");
+  return ground != run.summary.end() && ground->is_object() &&
+         ground->value("camera_height", 0.0) > 0.0;
+}
+
+Alignment RunAlignment(const RunFolder& run, const ReportOptions& options) {
+  if (options.sim3_without_metric_scale && options.alignment == Alignment::kSe3 &&
+      !RunHasMetricScale(run))
+    return Alignment::kSim3;
+  return options.alignment;
+}
+
 json RunReportData(const RunFolder& run, const ReportOptions& options) {
   options.Check();
   const double t0 = FirstTimestamp(run);
-  const AlignedRun aligned = Align(run, options.alignment);
+  const Alignment alignment = RunAlignment(run, options);
+  const AlignedRun aligned = Align(run, alignment);
   json data;
   data["kind"] = "run";
   data["title"] = run.dir.filename().empty() ? run.dir.parent_path().filename().string()
                                              : run.dir.filename().string();
   data["summary"] = SummaryJson(run);
-  data["alignment"] = aligned.eval ? ToString(options.alignment) : "none";
+  data["alignment"] = aligned.eval ? ToString(alignment) : "none";
+  if (alignment != options.alignment)
+    data["alignment_reason"] = "no metric scale without depth: se3 would score the map's unit";
   if (!aligned.note.empty()) data["alignment_note"] = aligned.note;
   data["t0"] = t0;
   data["frames"] = FramesJson(run, t0);

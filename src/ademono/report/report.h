@@ -21,6 +21,10 @@ namespace ademono {
 struct ReportOptions {
   // How the estimate is aligned to the ground truth before it is drawn and its error measured.
   Alignment alignment = Alignment::kSe3;
+  // A run without metric scale (summary.json: depth "none" and no ground_scale camera height) is
+  // aligned with sim3 when `alignment` is se3: se3 would score the unit of its two-view start,
+  // not its shape. Off when an alignment is asked for (`ademono report --align`, the YAML key).
+  bool sim3_without_metric_scale = true;
   // Map points embedded for the 3D view; beyond this an evenly strided subset (the report says so).
   int max_map_points = 100000;
   // Thumbnail frames (from the run folder's viz/ images) and their width in pixels.
@@ -54,6 +58,10 @@ struct RunFolder {
 
 // Throws InputError naming the file and the problem (missing, malformed, wrong schema).
 RunFolder ReadRunFolder(const std::filesystem::path& dir);
+// False for a run with neither depth nor a camera height (--depth none indoors).
+bool RunHasMetricScale(const RunFolder& run);
+// The alignment a single run's report uses (ReportOptions::sim3_without_metric_scale).
+Alignment RunAlignment(const RunFolder& run, const ReportOptions& options);
 // ASCII or binary little-endian PLY with float x, y, z and optional uchar red, green, blue.
 MapCloud ReadPlyPoints(const std::filesystem::path& path);
 

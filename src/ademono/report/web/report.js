@@ -370,7 +370,8 @@
     app.appendChild(trajPanel);
     if (D.alignment_note) trajPanel.appendChild(note(D.alignment_note));
     else trajPanel.appendChild(el('div', { class: 'hint' }, 'Estimate aligned to the ground truth with ' + D.alignment +
-      (T.scale !== undefined ? ' (scale ' + fmt(T.scale, 4) + ')' : '') + '; ATE RMSE over ' + T.err.length + ' poses: ' + fmt(T.ate.rmse, 4) + ' m.'));
+      (T.scale !== undefined ? ' (scale ' + fmt(T.scale, 4) + ')' : '') + '; ATE RMSE over ' + T.err.length + ' poses: ' + fmt(T.ate.rmse, 4) + ' m.' +
+      (D.alignment_reason ? ' Aligned with ' + D.alignment + ', not se3: ' + D.alignment_reason + '.' : '')));
     // Top view on the left, each axis over time on the right.
     const top = el('div', { id: 'plot-top' });
     const axesBox = el('div', { id: 'plot-axes' });
