@@ -268,7 +268,7 @@ int Run(const RunArgs& args) {
   if (report.accuracy) {
     // Without depth or a camera height the map's unit is its two-view start's: se3 then scores
     // that unit, not the trajectory's shape.
-    const bool scale_free = report.depth == "none" && !(report.options.depth.camera_height > 0);
+    const bool scale_free = report.depth == "none" && !report.options.depth.GroundScale();
     std::cout << "ATE se3 " << std::setprecision(4) << report.accuracy->ate_se3_rmse_m
               << " m, sim3 " << report.accuracy->ate_sim3_rmse_m << " m"
               << (scale_free ? " (no metric scale without depth: read sim3)" : "") << "\n";

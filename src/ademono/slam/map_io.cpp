@@ -417,17 +417,24 @@ double MapCameraHeight(const MapFileData& data) {
   }
 }
 
-MapScale MapScaleOf(const MapFileData& data) {
+namespace {
+
+// MapScaleOf with the camera height already read (the options are parsed once).
+MapScale ScaleOf(const MapFileData& data, double camera_height) {
   for (const MapKeyFrameRecord& kf : data.keyframes)
     for (float z : kf.depth)
       if (z > 0) return MapScale::kDepth;
-  return MapCameraHeight(data) > 0 ? MapScale::kRoad : MapScale::kArbitrary;
+  return camera_height > 0 ? MapScale::kRoad : MapScale::kArbitrary;
 }
+
+}  // namespace
+
+MapScale MapScaleOf(const MapFileData& data) { return ScaleOf(data, MapCameraHeight(data)); }
 
 MapFileSummary SummarizeMap(const MapFileData& data, uint64_t file_size) {
   MapFileSummary s;
-  s.scale = MapScaleOf(data);
   s.camera_height = MapCameraHeight(data);
+  s.scale = ScaleOf(data, s.camera_height);
   s.version = data.version;
   s.file_size = file_size;
   s.camera = data.camera;
