@@ -8,6 +8,11 @@
 //
 // Re-record the problem (the local BA of the last keyframe after --frames frames):
 //   build/release/bench_ba --record=tests/data/ba/seq_a_local_ba.bin --frames=120
+// A monocular window (--depth none, configs/network_indoor.yaml: 20 free keyframes, 2-dof rows),
+// to time without committing it:
+//   build/release/bench_ba --record=/tmp/none_ba.bin --frames=300 --depth=none
+//     --config=configs/network_indoor.yaml
+//   build/release/bench_ba --problem=/tmp/none_ba.bin --benchmark_filter=BM_LocalBa/analytic:1/solver:3
 #include <benchmark/benchmark.h>
 #include <yaml-cpp/yaml.h>
 
@@ -15,7 +20,9 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "ademono/core/memory.h"
 #include "ademono/depth/depth_factory.h"
 #include "ademono/io/sequence.h"
 #include "ademono/optimize/bundle_adjustment.h"
@@ -23,12 +30,14 @@
 
 namespace {
 
-const std::string kProblemPath =
-    std::string(ADEMONO_SOURCE_DIR) + "/tests/data/ba/seq_a_local_ba.bin";
+std::string& ProblemPath() {
+  static std::string path = std::string(ADEMONO_SOURCE_DIR) + "/tests/data/ba/seq_a_local_ba.bin";
+  return path;
+}
 
 const ademono::BundleAdjustmentProblem& Problem() {
   static const ademono::BundleAdjustmentProblem problem =
-      ademono::ReadBundleAdjustmentProblem(kProblemPath);
+      ademono::ReadBundleAdjustmentProblem(ProblemPath());
   return problem;
 }
 
@@ -86,23 +95,24 @@ BENCHMARK(BM_LocalBaIterations)
     ->Args({3, 5})
     ->Unit(benchmark::kMillisecond);
 
-// Runs seq-a frames [0, frames) with configs/7scenes.yaml and writes the last local BA problem.
-int Record(const std::string& path, size_t frames) {
-  const std::string config = std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml";
+// Runs seq-a frames [0, frames) with `config` and `depth` and writes the last local BA problem.
+int Record(const std::string& path, size_t frames, const std::string& config,
+           const std::string& depth) {
   const ademono::SystemOptions options =
       ademono::SystemOptions::FromYaml(YAML::LoadFile(config), config);
   auto sequence =
       ademono::OpenSequence(std::string("7scenes:") + ADEMONO_SHARED_DIR + "/data/7scenes-seq-a");
   ademono::DepthFactoryContext context;
   context.sequence = sequence.get();
-  auto provider = ademono::MakeDepthProvider("sensor", context);
+  auto provider = ademono::MakeDepthProvider(depth, context);
   ademono::BundleAdjustmentProblem last;
   ademono::SetBundleAdjustmentObserver(
       [&last](const ademono::BundleAdjustmentProblem& problem) { last = problem; });
   ademono::System system(sequence->GetCamera(), options);
   for (size_t i = 0; i < frames && i < sequence->Size(); ++i) {
     const ademono::FrameData frame = sequence->Load(i);
-    system.TrackFrame(frame, provider->Depth(frame, sequence->GetCamera()), {});
+    system.TrackFrame(
+        frame, provider ? provider->Depth(frame, sequence->GetCamera()) : cv::Mat(), {});
   }
   ademono::SetBundleAdjustmentObserver(nullptr);
   if (last.observations.empty()) {
@@ -118,13 +128,31 @@ int Record(const std::string& path, size_t frames) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string record;
+  // As the ademono executable: without it every solve faults its linearisation's pages in again
+  // (a monocular window of 20 free keyframes: 73 ms instead of the run's 22 ms).
+  ademono::KeepLargeBuffersInTheHeap(ademono::kMmapThresholdBytes, ademono::kTrimThresholdBytes);
+  std::string record, depth = "sensor";
+  std::string config = std::string(ADEMONO_SOURCE_DIR) + "/configs/7scenes.yaml";
   size_t frames = 120;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strncmp(argv[i], "--record=", 9) == 0) record = argv[i] + 9;
-    if (std::strncmp(argv[i], "--frames=", 9) == 0) frames = std::stoul(argv[i] + 9);
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--record=", 9) == 0) {
+      record = argv[i] + 9;
+    } else if (std::strncmp(argv[i], "--frames=", 9) == 0) {
+      frames = std::stoul(argv[i] + 9);
+    } else if (std::strncmp(argv[i], "--depth=", 8) == 0) {
+      depth = argv[i] + 8;
+    } else if (std::strncmp(argv[i], "--config=", 9) == 0) {
+      config = argv[i] + 9;
+    } else if (std::strncmp(argv[i], "--problem=", 10) == 0) {
+      ProblemPath() = argv[i] + 10;
+    } else {
+      rest.push_back(argv[i]);
+    }
   }
-  if (!record.empty()) return Record(record, frames);
+  if (!record.empty()) return Record(record, frames, config, depth);
+  argc = static_cast<int>(rest.size());
+  argv = rest.data();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -15,7 +15,8 @@ namespace {
 
 constexpr int kMaxInvalidSteps = 5;  // Ceres' max_num_consecutive_invalid_steps
 
-using Mat36 = Eigen::Matrix<double, 3, 6>;
+using Mat63 = Eigen::Matrix<double, 6, 3>;
+static_assert(sizeof(Mat63) == 18 * sizeof(double), "a vector of them is one array of doubles");
 using Mat66 = Eigen::Matrix<double, 6, 6>;
 
 enum class Kind { kMono, kStereo, kPlane };
@@ -120,7 +121,9 @@ class SchurLm {
   Eigen::VectorXd gf_;
   std::vector<Eigen::Matrix3d> hpp_;
   std::vector<Eigen::Vector3d> gp_;
-  std::vector<Mat36> w_;  // per point slot: J_point^T J_block (a normal's in the first 2 columns)
+  // Per point slot: W^T = J_block^T J_point, stored 6x3 column-major so that its products
+  // vectorise (a normal's in the first 2 rows).
+  std::vector<Mat63> wt_;
   Eigen::VectorXd scale_f_;
   std::vector<Eigen::Vector3d> scale_p_;
   bool scaled_ = false;
@@ -129,6 +132,7 @@ class SchurLm {
   Eigen::VectorXd step_f_;
   std::vector<Eigen::Vector3d> step_p_;
   std::vector<Eigen::Matrix3d> inverse_;
+  std::vector<Mat63> vt_;  // scratch: one point's W_i^T A^-1, per slot
   std::vector<double> candidate_cameras_, candidate_points_;
 };
 
@@ -240,10 +244,14 @@ void SchurLm::Build(const std::vector<bool>& skip, const std::vector<size_t>& no
   lin_.resize(rows_.size());
   hpp_.resize(num_free_points);
   gp_.resize(num_free_points);
-  w_.resize(point_slots_.size());
+  wt_.resize(point_slots_.size());
   scale_p_.resize(num_free_points);
   step_p_.resize(num_free_points);
   inverse_.resize(num_free_points);
+  size_t max_slots = 0;
+  for (size_t p = 0; p < num_free_points; ++p)
+    max_slots = std::max(max_slots, point_slot_begin_[p + 1] - point_slot_begin_[p]);
+  vt_.resize(max_slots);
 }
 
 template <int kDim>
@@ -353,10 +361,10 @@ void SchurLm::AccumulateRow(const Row& row, const Linearised& l) {
     hpp_[p].noalias() += jp.transpose() * jp;
     gp_[p].noalias() += jp.transpose() * r;
     const size_t first = point_slot_begin_[p];
-    if (oc >= 0) w_[first + row.camera_slot].noalias() += jp.transpose() * jc;
+    if (oc >= 0) wt_[first + row.camera_slot].noalias() += jc.transpose() * jp;
     if constexpr (kDim == 1) {
       if (on >= 0)
-        w_[first + row.normal_slot_in_point].leftCols<2>().noalias() += jp.transpose() * jn;
+        wt_[first + row.normal_slot_in_point].topRows<2>().noalias() += jn.transpose() * jp;
     }
   }
 }
@@ -368,7 +376,9 @@ void SchurLm::BuildNormalEquations() {
     hpp_[p].setZero();
     gp_[p].setZero();
   }
-  for (Mat36& w : w_) w.setZero();
+  // One fill over the contiguous blocks: per block it was a string store each, a quarter of this
+  // function's time.
+  if (!wt_.empty()) Eigen::Map<Eigen::VectorXd>(wt_[0].data(), 18 * wt_.size()).setZero();
   for (size_t i = 0; i < rows_.size(); ++i) {
     switch (rows_[i].kind) {
       case Kind::kMono:
@@ -402,21 +412,28 @@ bool SchurLm::ComputeStep(double radius) {
     inverse_[p] = llt.solve(Eigen::Matrix3d::Identity());
     const Eigen::Vector3d inv_g = inverse_[p] * gp_[p];
     const size_t begin = point_slot_begin_[p], end = point_slot_begin_[p + 1];
+    // W_i^T A^-1 per slot, 6x3 column-major: a block W_i^T A^-1 W_j is then three 6-vector
+    // multiply-adds per column, which the compiler vectorises (through a transposed 3x6 view it
+    // was scalar code: the whole local BA 1.4x slower).
+    for (size_t i = begin; i < end; ++i) vt_[i - begin].noalias() = wt_[i] * inverse_[p];
     for (size_t i = begin; i < end; ++i) {
       const Block& bi = blocks_[point_slots_[i]];
-      const Mat36 v = inverse_[p] * w_[i];
-      rhs.segment(bi.offset, bi.size) += (w_[i].transpose() * inv_g).head(bi.size);
+      const Mat63& vi = vt_[i - begin];
+      rhs.segment(bi.offset, bi.size) += (wt_[i] * inv_g).head(bi.size);
       for (size_t j = i; j < end; ++j) {
         const Block& bj = blocks_[point_slots_[j]];
-        const Mat66 m = v.transpose() * w_[j];  // (A^-1 W_i)^T W_j = W_i^T A^-1 W_j
         // Only the upper triangle: the Cholesky below reads nothing else.
         if (bi.size == 6 && bj.size == 6) {
           if (bi.offset <= bj.offset) {
-            reduced.block<6, 6>(bi.offset, bj.offset) -= m;
+            reduced.block<6, 6>(bi.offset, bj.offset).noalias() -= vi * wt_[j].transpose();
           } else {
-            reduced.block<6, 6>(bj.offset, bi.offset) -= m.transpose();
+            reduced.block<6, 6>(bj.offset, bi.offset).noalias() -=
+                vt_[j - begin] * wt_[i].transpose();
           }
-        } else if (bi.offset <= bj.offset) {
+          continue;
+        }
+        const Mat66 m = vi * wt_[j].transpose();  // W_i^T A^-1 W_j
+        if (bi.offset <= bj.offset) {
           reduced.block(bi.offset, bj.offset, bi.size, bj.size) -=
               m.topLeftCorner(bi.size, bj.size);
         } else {
@@ -434,7 +451,7 @@ bool SchurLm::ComputeStep(double radius) {
     Eigen::Vector3d b = -gp_[p];
     for (size_t i = point_slot_begin_[p]; i < point_slot_begin_[p + 1]; ++i) {
       const Block& bi = blocks_[point_slots_[i]];
-      b.noalias() -= w_[i].leftCols(bi.size) * step_f_.segment(bi.offset, bi.size);
+      b.noalias() -= wt_[i].topRows(bi.size).transpose() * step_f_.segment(bi.offset, bi.size);
     }
     step_p_[p] = inverse_[p] * b;
     if (!step_p_[p].allFinite()) return false;
