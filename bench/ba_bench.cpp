@@ -150,7 +150,14 @@ int main(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  if (!record.empty()) return Record(record, frames, config, depth);
+  // A missing or bad file, config or dataset: one line and exit 2, not an abort mid-benchmark.
+  try {
+    if (!record.empty()) return Record(record, frames, config, depth);
+    Problem();
+  } catch (const std::exception& e) {
+    std::cerr << "bench_ba: " << e.what() << "\n";
+    return 2;
+  }
   argc = static_cast<int>(rest.size());
   argv = rest.data();
   benchmark::Initialize(&argc, argv);
