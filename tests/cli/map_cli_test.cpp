@@ -79,8 +79,8 @@ TEST_F(MapCliTest, MapInfoPrintsWhatTheMapHolds) {
 }
 
 // A map built with --depth none is in the units of its two-view start: `map info` says so, and a
-// run with depth refuses it before its first frame (one line naming the file, exit 2, nothing
-// written); a run without depth uses it.
+// run with sensor depth refuses it before its first frame (one line naming the file, exit 2,
+// nothing written); a run without depth uses it, and a run with a network gives it metres.
 TEST_F(MapCliTest, AMapWithoutMetricScaleIsRefusedWithDepth) {
   const fs::path none_map = *dir_ / "none.map";
   const CliResult built = RunCli("run --dataset " + Dataset() + " --depth none --frames 0:90" +
@@ -109,6 +109,19 @@ TEST_F(MapCliTest, AMapWithoutMetricScaleIsRefusedWithDepth) {
   ASSERT_EQ(g.code, 0) << g.out;
   const auto summary = nlohmann::json::parse(ReadFile(geometric / "summary.json"));
   EXPECT_GE(summary["tracked"].get<int>(), 25) << g.out;
+
+  // A network's depth is a prior measured against the map frame by frame: the map takes its
+  // long-run scale, so each frame's network-to-map ratio comes out near 1 (0.69 for every frame
+  // while the map kept its two-view units).
+  const fs::path network = *dir_ / "none_with_network";
+  const CliResult n = RunCli("run --dataset " + Dataset() + " --depth model:" +
+                             ADEMONO_SHARED_DIR + "/models/fastdepth_nyu_320.onnx" +
+                             " --frames 60:90 --load-map " + none_map.string() + " --out " +
+                             network.string());
+  ASSERT_EQ(n.code, 0) << n.out;
+  const auto with_network = nlohmann::json::parse(ReadFile(network / "summary.json"));
+  EXPECT_GE(with_network["tracked"].get<int>(), 25) << n.out;
+  EXPECT_NEAR(with_network["depth_scale"]["median"].get<double>(), 1.0, 0.1) << n.out;
 }
 
 TEST_F(MapCliTest, BadMapsExitTwoWithOneLineNamingTheFile) {

@@ -183,7 +183,7 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   if (!options.load_map.empty()) {
     system.LoadMap(options.load_map, options.localize_only);
     // Before the first frame, not at it: nothing prepared or written for a run that cannot start.
-    if (depth != nullptr && !system.LoadedMapHasMetricScale())
+    if (depth != nullptr && !options.system.depth.IsPrior() && !system.LoadedMapHasMetricScale())
       ThrowInputError(options.load_map, ScaleFreeMapProblem());
   }
   const SyntheticTruth truth(sequence.Path());

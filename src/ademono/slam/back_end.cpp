@@ -73,8 +73,9 @@ std::string CameraText(const Camera& c) {
 }  // namespace
 
 std::string ScaleFreeMapProblem() {
-  return "the map has no metric scale (it was built with --depth none and no camera height); "
-         "load it with --depth none, or build it with depth";
+  return "the map has no metric scale (it was built with --depth none and no camera height) and "
+         "this run takes depth as a measurement in metres; load it with --depth none or a depth "
+         "network (the map then takes the network's long-run scale), or build it with depth";
 }
 
 void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
@@ -97,7 +98,7 @@ void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
     loaded_map_ = data;
   }
   tracking_.AssertMapHeld();  // tracking's name for the same lock
-  tracking_.StartInLoadedMap(localize_only);
+  tracking_.StartInLoadedMap(localize_only, scale_free_map_.empty());
 }
 
 void BackEnd::SaveMap(const std::filesystem::path& path) {
@@ -155,8 +156,10 @@ int BackEnd::CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::
 
 BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
                              const FilteredFrame& filtered) {
-  // Depth in metres against a map in arbitrary units: every depth residual would pull the pose.
-  if (!scale_free_map_.empty() && !depth.empty())
+  // Sensor depth in metres against a map in arbitrary units: every depth residual would pull the
+  // pose. A network's depth is a prior whose scale each frame measures against the map, and the
+  // anchor then gives the map the network's long-run scale, as it does a new map.
+  if (!scale_free_map_.empty() && !depth.empty() && !options_.depth.IsPrior())
     ThrowInputError(scale_free_map_, ScaleFreeMapProblem());
   BackEndResult result;
   const auto start = std::chrono::steady_clock::now();

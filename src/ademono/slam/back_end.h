@@ -73,9 +73,10 @@ class BackEnd {
   // points are frozen; tracking.temporary_map may add temporary ones beside them, which are never
   // saved) and no loop is closed. SaveMap finishes local mapping (Shutdown) and writes the map
   // atomically (after localisation only: the loaded map as it was read).
-  // A map without metric scale (--depth none without a camera height: MapScaleOf) is tracked only
-  // without depth: a frame with depth (sensor or network) then throws InputError naming the map,
-  // as the runner does before its first frame (ScaleFreeMapProblem).
+  // A map without metric scale (--depth none without a camera height: MapScaleOf) is tracked
+  // without depth, or with a network's depth (a prior: the anchor gives the map the network's
+  // long-run scale, as it does a new map); a frame with sensor depth throws InputError naming the
+  // map, as the runner does before its first frame (ScaleFreeMapProblem).
   void LoadMap(const std::filesystem::path& path, bool localize_only,
                const std::shared_ptr<const ScalePyramid>& pyramid);
   // False after LoadMap of a map without metric scale; true otherwise.

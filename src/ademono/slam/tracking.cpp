@@ -74,8 +74,9 @@ Tracking::Tracking(Map& map, const LocalMapping& local_mapping, const SystemOpti
       options_(options),
       monocular_initialization_(options) {}
 
-void Tracking::StartInLoadedMap(bool localize_only) {
+void Tracking::StartInLoadedMap(bool localize_only, bool metric) {
   map_loaded_ = true;
+  loaded_map_metric_ = metric;
   localize_only_ = localize_only;
   odometry_localisation_ = localize_only && !options_.tracking.temporary_map;
   state_ = TrackingState::kLost;
@@ -291,11 +292,14 @@ TrackingOutput Tracking::Track(std::shared_ptr<const FrameFeatures> features, si
         if (recent_good_.size() > kMeanVelocityFrames) recent_good_.pop_front();
       }
       out.match_state = MatchStates(frame);
+      // A loaded map without metric scale is anchored at every frame, not only at keyframes: a
+      // run may make none (localisation by odometry, or a stretch the map already covers).
+      if (map_loaded_ && !loaded_map_metric_ && !weak) AnchorScale(frame);
       // Localisation only with a temporary map: keyframes too (local mapping keeps the loaded
       // ones fixed; they are never saved).
       if (!odometry_localisation_ && !weak && NeedNewKeyFrame(frame)) {
         std::optional<KeyFrame::Ground> ground;
-        if (options_.depth.GroundScale() && !map_loaded_) {
+        if (options_.depth.GroundScale() && !ScaleHeldByLoadedMap()) {
           KeyFrame::Ground measured;
           if (const std::optional<double> height = MeasureGround(frame, true, &measured)) {
             ground_heights_.push_back(*height);
@@ -496,8 +500,8 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
 }
 
 void Tracking::AnchorScale(Frame& frame) {
-  // A loaded map's scale is the anchor (this session's network may read differently).
-  if (!local_mapping_.Idle() || map_loaded_) return;
+  // A loaded metric map's scale is the anchor (this session's network may read differently).
+  if (!local_mapping_.Idle() || ScaleHeldByLoadedMap()) return;
   if (options_.depth.GroundScale()) {
     // The camera's height above the ground as the map has it, over the keyframes so far.
     if (ground_heights_.empty()) return;
@@ -513,7 +517,8 @@ void Tracking::AnchorScale(Frame& frame) {
 }
 
 std::optional<double> Tracking::ScaleSigma() {
-  if (map_loaded_) return std::nullopt;  // the loaded map's scale: nothing this run estimated
+  // The loaded map's scale: nothing this run estimated.
+  if (ScaleHeldByLoadedMap()) return std::nullopt;
   if (options_.depth.GroundScale()) {
     if (ground_heights_.size() < 3) return std::nullopt;
     if (ground_spread_samples_ != ground_heights_.size()) {

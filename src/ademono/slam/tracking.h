@@ -127,9 +127,11 @@ class Tracking {
   int NumRelocalisations() const { return num_relocalisations_; }
   // After a saved map was restored into the (otherwise empty) map: the first frames relocalise
   // in it (global relocalisation through the keyframe database) instead of initialising a new
-  // map, and the loaded map keeps its scale (no anchoring to this session's network). With
-  // `localize_only` the map never changes: no keyframe, no point, no point statistics.
-  void StartInLoadedMap(bool localize_only) ADEMONO_REQUIRES(map_.mutex);
+  // map. A `metric` map keeps its scale (no anchoring to this session's network or road); a map
+  // without one (built with --depth none) takes it from them as a new map would, by the same
+  // anchor. With `localize_only` the map never changes otherwise: no keyframe, no point, no point
+  // statistics.
+  void StartInLoadedMap(bool localize_only, bool metric) ADEMONO_REQUIRES(map_.mutex);
   bool LocalizeOnly() const { return localize_only_; }
   // depth.camera_height: the camera's height above the ground plane, measured at initialisation
   // and at every keyframe, in the map's current units (the map is rescaled whenever their
@@ -259,6 +261,9 @@ class Tracking {
   std::vector<double> ground_heights_;  // depth.camera_height: GroundHeights()
   std::vector<size_t> ground_height_frames_;
   bool map_loaded_ = false;
+  bool loaded_map_metric_ = false;
+  // A loaded metric map holds the scale: this run's network or road does not move it.
+  bool ScaleHeldByLoadedMap() const { return map_loaded_ && loaded_map_metric_; }
   bool localize_only_ = false;
   // Localisation only without a temporary map (tracking.temporary_map false): frame-to-frame
   // odometry where the loaded map is out of view.
