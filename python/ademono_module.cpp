@@ -621,8 +621,8 @@ PYBIND11_MODULE(ademono, m) {
           "loaded_map_has_metric_scale",
           [](PySystem& s) { return s.Get().LoadedMapHasMetricScale(); },
           "False after load_map of a map built without depth (--depth none) and without a "
-          "camera height: track it without depth, or with a depth network (the map then takes "
-          "the network's long-run scale); sensor depth is refused")
+          "camera height, until a depth sensor gave it metres at its first tracked frame (a "
+          "depth network gives it its long-run scale frame by frame)")
       .def(
           "trajectory", [](PySystem& s) { return TrajectoryToTuple(s.Get().FrameTrajectory()); },
           "(timestamps (N,), world_from_cam (N, 4, 4)) of the tracked frames")

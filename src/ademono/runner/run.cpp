@@ -182,9 +182,6 @@ RunReport RunSequence(const Sequence& sequence, DepthProvider* depth, Detector* 
   System system(sequence.GetCamera(), options.system);
   if (!options.load_map.empty()) {
     system.LoadMap(options.load_map, options.localize_only);
-    // Before the first frame, not at it: nothing prepared or written for a run that cannot start.
-    if (depth != nullptr && !options.system.depth.IsPrior() && !system.LoadedMapHasMetricScale())
-      ThrowInputError(options.load_map, ScaleFreeMapProblem());
   }
   const SyntheticTruth truth(sequence.Path());
   const bool score = options.score_synthetic_truth && truth.Available();

@@ -1,5 +1,7 @@
 #include "ademono/slam/back_end.h"
 
+#include <spdlog/spdlog.h>
+
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -71,12 +73,6 @@ std::string CameraText(const Camera& c) {
 }
 
 }  // namespace
-
-std::string ScaleFreeMapProblem() {
-  return "the map has no metric scale (it was built with --depth none and no camera height) and "
-         "this run takes depth as a measurement in metres; load it with --depth none or a depth "
-         "network (the map then takes the network's long-run scale), or build it with depth";
-}
 
 void BackEnd::LoadMap(const std::filesystem::path& path, bool localize_only,
                       const std::shared_ptr<const ScalePyramid>& pyramid) {
@@ -156,22 +152,36 @@ int BackEnd::CullPointsOnMovingObjects(const Rigid3d& cam_from_world, const cv::
 
 BackEndResult BackEnd::Track(const FrameData& frame, const cv::Mat& depth,
                              const FilteredFrame& filtered) {
-  // Sensor depth in metres against a map in arbitrary units: every depth residual would pull the
-  // pose. A network's depth is a prior whose scale each frame measures against the map, and the
-  // anchor then gives the map the network's long-run scale, as it does a new map.
-  if (!scale_free_map_.empty() && !depth.empty() && !options_.depth.IsPrior())
-    ThrowInputError(scale_free_map_, ScaleFreeMapProblem());
+  // Sensor depth in metres against a map in other units: every depth residual would pull the
+  // pose. Such frames are tracked without their depths until one gives the ratio of the sensor's
+  // depths to the map's; the world is then multiplied by it and the depths used from the next
+  // frame on. (A network's depth is a prior whose scale each frame measures against the map; the
+  // anchor gives the map the network's long-run scale, as it does a new map.)
+  const bool measure_scale =
+      !scale_free_map_.empty() && !depth.empty() && !options_.depth.IsPrior();
   BackEndResult result;
   const auto start = std::chrono::steady_clock::now();
   TrackingOutput& out = result.tracking;
   {
     MutexLock lock(map_.mutex);
     tracking_.AssertMapHeld();
-    out = tracking_.Track(filtered.features, frame.index, frame.timestamp, filtered.in_dynamic_box);
+    out = tracking_.Track(measure_scale ? WithoutDepth(*filtered.features) : filtered.features,
+                          frame.index, frame.timestamp, filtered.in_dynamic_box);
+    if (measure_scale && out.tracked) {
+      if (const std::optional<double> scale = tracking_.SensorToMapScale(*filtered.features)) {
+        tracking_.GiveLoadedMapScale(*scale);
+        out.cam_from_world.translation() *= *scale;
+        spdlog::info("{}: the map had no metric scale; the depth sensor gives it x{:.4f}",
+                     scale_free_map_.string(), *scale);
+        scale_free_map_.clear();
+      }
+    }
     // The one rule for map points on moving objects: occlusion-aware, so it needs this frame's
     // depth map; a frame without one culls nothing (it cannot tell a left-behind point from the
     // background the box covers).
-    if (out.tracked && !depth.empty() && options_.filter.enable_dynamic_removal &&
+    const bool depth_in_map_units = !measure_scale || scale_free_map_.empty();
+    if (out.tracked && !depth.empty() && depth_in_map_units &&
+        options_.filter.enable_dynamic_removal &&
         !tracking_.LocalizeOnly() && !filtered.moving_detections.empty())
       out.dynamic_points_culled +=
           CullPointsOnMovingObjects(out.cam_from_world, depth, filtered.moving_detections);

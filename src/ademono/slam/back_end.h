@@ -26,10 +26,6 @@
 
 namespace ademono {
 
-// Why a map without metric scale cannot be extended or localised in with depth: the message of
-// the InputError that names its file.
-std::string ScaleFreeMapProblem();
-
 // Which frame poses a trajectory holds (BackEnd::FrameTrajectory).
 enum class FramePoses { kWritten, kResolved };
 
@@ -74,12 +70,13 @@ class BackEnd {
   // saved) and no loop is closed. SaveMap finishes local mapping (Shutdown) and writes the map
   // atomically (after localisation only: the loaded map as it was read).
   // A map without metric scale (--depth none without a camera height: MapScaleOf) is tracked
-  // without depth, or with a network's depth (a prior: the anchor gives the map the network's
-  // long-run scale, as it does a new map); a frame with sensor depth throws InputError naming the
-  // map, as the runner does before its first frame (ScaleFreeMapProblem).
+  // without depth; with a network's depth (a prior) the anchor gives it the network's long-run
+  // scale, as it does a new map; with sensor depth its frames are tracked without their depths
+  // until one measures the sensor's depths against the map, and the world is multiplied by that.
   void LoadMap(const std::filesystem::path& path, bool localize_only,
                const std::shared_ptr<const ScalePyramid>& pyramid);
-  // False after LoadMap of a map without metric scale; true otherwise.
+  // False after LoadMap of a map without metric scale, until a depth sensor gave it one; true
+  // otherwise.
   bool LoadedMapHasMetricScale() const { return scale_free_map_.empty(); }
   void SaveMap(const std::filesystem::path& path);
   // Place recognition index of the live keyframes (thread-safe on its own).

@@ -130,6 +130,13 @@ std::shared_ptr<const FrameFeatures> WithoutKeypoints(const FrameFeatures& featu
   return f;  // no grid either: FeaturesInArea finds nothing
 }
 
+std::shared_ptr<const FrameFeatures> WithoutDepth(const FrameFeatures& features) {
+  auto f = std::make_shared<FrameFeatures>(features);
+  std::fill(f->depth.begin(), f->depth.end(), -1.f);
+  std::fill(f->u_right.begin(), f->u_right.end(), -1.f);
+  return f;
+}
+
 std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale) {
   auto f = std::make_shared<FrameFeatures>(features);
   f->depth_scale *= scale;

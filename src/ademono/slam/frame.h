@@ -100,6 +100,10 @@ std::shared_ptr<const FrameFeatures> MakeFrameFeatures(const Camera& camera,
 // keyframe needs, whose pose still resolves the frames that referenced it.
 std::shared_ptr<const FrameFeatures> WithoutKeypoints(const FrameFeatures& features);
 
+// The same features with no depth (every depth and u_right unknown): a depth sensor's frame
+// tracked against a map in other units (BackEnd::Track).
+std::shared_ptr<const FrameFeatures> WithoutDepth(const FrameFeatures& features);
+
 // The same features with every depth multiplied by `scale` (u_right recomputed, depth_scale
 // accumulated): the per-frame scale correction of network depth.
 std::shared_ptr<const FrameFeatures> RescaleDepth(const FrameFeatures& features, float scale);

@@ -641,6 +641,25 @@ Rigid3d ResolveFramePose(const FrameRecord& record) {
   return InterpolatePose(world_from_cam_a, world_from_cam_b, alpha).inverse();
 }
 
+std::optional<double> Tracking::SensorToMapScale(const FrameFeatures& with_depth) const {
+  if (!last_frame_ || !last_frame_->cam_from_world) return std::nullopt;
+  const Frame& frame = *last_frame_;
+  std::vector<double> ratios;
+  for (size_t i = 0; i < frame.map_points.size() && i < with_depth.depth.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad || !(with_depth.depth[i] > 0)) continue;
+    const double z = (*frame.cam_from_world * p->position).z();
+    if (z > 0) ratios.push_back(with_depth.depth[i] / z);
+  }
+  if (ratios.size() < kMinSensorScaleSamples) return std::nullopt;
+  return Median(ratios);
+}
+
+void Tracking::GiveLoadedMapScale(double factor) {
+  if (last_frame_) RescaleWorld(*last_frame_, factor);
+  loaded_map_metric_ = true;
+}
+
 void Tracking::RescaleWorld(Frame& frame, double factor) {
   map_.Rescale(factor);
   auto scale_translation = [factor](Rigid3d& pose) { pose.translation() *= factor; };
@@ -650,7 +669,9 @@ void Tracking::RescaleWorld(Frame& frame, double factor) {
     scale_translation(r.cam_from_next);
     r.depth_scale *= factor;
   }
-  if (last_frame_ && last_frame_->cam_from_world) scale_translation(*last_frame_->cam_from_world);
+  // The frame may be the last one itself (GiveLoadedMapScale): scaled once, below.
+  if (last_frame_ && last_frame_->cam_from_world && &*last_frame_ != &frame)
+    scale_translation(*last_frame_->cam_from_world);
   if (velocity_) scale_translation(*velocity_);
   for (auto& [id, pose] : recent_good_) scale_translation(pose);
   if (last_good_pose_) scale_translation(*last_good_pose_);

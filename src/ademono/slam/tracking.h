@@ -132,6 +132,16 @@ class Tracking {
   // anchor. With `localize_only` the map never changes otherwise: no keyframe, no point, no point
   // statistics.
   void StartInLoadedMap(bool localize_only, bool metric) ADEMONO_REQUIRES(map_.mutex);
+  // A loaded map without metric scale and a depth sensor (BackEnd::Track tracks the sensor's
+  // frames without their depths until then): the ratio of the sensor's depths to the map's over
+  // the map points of the frame just tracked, the median of at least kMinSensorScaleSamples, or
+  // nothing. `with_depth`: that frame's features with the sensor's depths.
+  std::optional<double> SensorToMapScale(const FrameFeatures& with_depth) const
+      ADEMONO_REQUIRES(map_.mutex);
+  static constexpr size_t kMinSensorScaleSamples = 30;
+  // Multiplies the world (map, trajectory, motion, the frame just tracked) by `factor`, and holds
+  // the loaded map's scale from then on.
+  void GiveLoadedMapScale(double factor) ADEMONO_REQUIRES(map_.mutex);
   bool LocalizeOnly() const { return localize_only_; }
   // depth.camera_height: the camera's height above the ground plane, measured at initialisation
   // and at every keyframe, in the map's current units (the map is rescaled whenever their
