@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
@@ -318,67 +319,61 @@ TEST(MonocularTest, AMapBuiltWithoutDepthTakesTheScaleOfTheDepthItIsLoadedWith) 
   EXPECT_NE(text.find("scale: arbitrary (built with --depth none"), std::string::npos) << text;
   EXPECT_NE(text.find("bounding box (map units)"), std::string::npos);
 
-  std::optional<double> map_to_metric;  // the sim3 scale of the frames tracked in the loaded map
-  {
-    System without_depth(scene.camera, Options(DepthInput::kNone));
-    without_depth.LoadMap(path, true);
+  // Frames [first, end) tracked on the saved map with `input`'s options; `depth_of` turns a
+  // frame's rendered depth into the run's (none for DepthInput::kNone). Also tells whether the
+  // map had metric scale once they were tracked.
+  struct LoadedRun {
     OfficeRun run;
-    for (size_t k = 110; k < 130; ++k) {
-      const FrameData frame = frame_at(k, nullptr);
-      run.tracked += without_depth.TrackFrame(frame, {}, {}).tracked;
-      run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
+    bool metric_after = false;
+  };
+  auto track_on_map = [&](DepthInput input, bool localize_only, size_t first, size_t end,
+                          const std::function<cv::Mat(const cv::Mat&, size_t)>& depth_of) {
+    System system(scene.camera, Options(input));
+    system.LoadMap(path, localize_only);
+    EXPECT_FALSE(system.LoadedMapHasMetricScale());
+    LoadedRun out;
+    for (size_t k = first; k < end; ++k) {
+      cv::Mat rendered;
+      const FrameData frame = frame_at(k, &rendered);
+      const cv::Mat depth = depth_of ? depth_of(rendered, k) : cv::Mat();
+      out.run.tracked += system.TrackFrame(frame, depth, {}).tracked;
+      out.run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
     }
-    EXPECT_GT(run.tracked, 15);  // relocalised in the loaded map and tracked on it
-    without_depth.Shutdown();
-    run.estimate = without_depth.FrameTrajectory();
-    map_to_metric = Ate(run, Alignment::kSim3).gt_from_est.scale;
+    system.Shutdown();
+    out.run.estimate = system.FrameTrajectory();
+    out.metric_after = system.LoadedMapHasMetricScale();
+    return out;
+  };
+
+  // Without depth: relocalised in the loaded map and tracked on it, in the map's units.
+  const LoadedRun geometric = track_on_map(DepthInput::kNone, true, 110, 130, nullptr);
+  EXPECT_GT(geometric.run.tracked, 15);
+  const double map_to_metric = Ate(geometric.run, Alignment::kSim3).gt_from_est.scale;
+  EXPECT_GT(std::abs(std::log(map_to_metric)), std::log(1.3)) << map_to_metric;
+  for (const bool localize_only : {false, true}) {
+    const LoadedRun sensor = track_on_map(DepthInput::kExact, localize_only, 90, frames,
+                                          [](const cv::Mat& depth, size_t) { return depth; });
+    EXPECT_TRUE(sensor.metric_after) << "localize_only " << localize_only;
+    EXPECT_GT(sensor.run.tracked, 50) << "localize_only " << localize_only;
+    // Measured: 0.977 extending the map, 0.962 localising only (the frozen map keeps the scale
+    // drift of its geometric start); its own units read 3.83.
+    EXPECT_NEAR(Ate(sensor.run, Alignment::kSim3).gt_from_est.scale, 1.0, 0.06)
+        << "localize_only " << localize_only;
   }
   // The network reads 0.9x: the frames tracked with it come out at that scale, wherever the
   // loaded map's units were.
-  ASSERT_TRUE(map_to_metric.has_value());
-  EXPECT_GT(std::abs(std::log(*map_to_metric)), std::log(1.3)) << *map_to_metric;
+  SimulatedDepthOptions network;
+  network.scale = 0.9;
+  const SimulatedDepthProvider provider(network, nullptr);
   for (const bool localize_only : {false, true}) {
-    System with_depth(scene.camera, Options(DepthInput::kExact));
-    with_depth.LoadMap(path, localize_only);
-    EXPECT_FALSE(with_depth.LoadedMapHasMetricScale());
-    OfficeRun run;
-    for (size_t k = 90; k < frames; ++k) {
-      cv::Mat depth;
-      const FrameData frame = frame_at(k, &depth);
-      run.tracked += with_depth.TrackFrame(frame, depth, {}).tracked;
-      run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
-    }
-    with_depth.Shutdown();
-    run.estimate = with_depth.FrameTrajectory();
-    EXPECT_TRUE(with_depth.LoadedMapHasMetricScale()) << "localize_only " << localize_only;
-    EXPECT_GT(run.tracked, 50) << "localize_only " << localize_only;
-    // Measured: 0.977 extending the map, 0.962 localising only (the frozen map keeps the scale
-    // drift of its geometric start); its own units read 3.83.
-    EXPECT_NEAR(Ate(run, Alignment::kSim3).gt_from_est.scale, 1.0, 0.06)
-        << "localize_only " << localize_only;
-  }
-  for (const bool localize_only : {false, true}) {
-    SimulatedDepthOptions network;
-    network.scale = 0.9;
-    const SimulatedDepthProvider provider(network, nullptr);
-    System with_network(scene.camera, Options(DepthInput::kNetwork));
-    with_network.LoadMap(path, localize_only);
-    EXPECT_FALSE(with_network.LoadedMapHasMetricScale());
-    OfficeRun run;
-    for (size_t k = 90; k < frames; ++k) {
-      cv::Mat depth;
-      const FrameData frame = frame_at(k, &depth);
-      run.tracked +=
-          with_network.TrackFrame(frame, provider.Degrade(depth, k), {}).tracked;
-      run.truth.push_back({frame.timestamp, scene.world_from_cam(frame.timestamp)});
-    }
-    with_network.Shutdown();
-    run.estimate = with_network.FrameTrajectory();
-    EXPECT_GT(run.tracked, 50) << "localize_only " << localize_only;
-    const EvalResult ate = Ate(run, Alignment::kSim3);
+    const LoadedRun with_network =
+        track_on_map(DepthInput::kNetwork, localize_only, 90, frames,
+                     [&](const cv::Mat& depth, size_t k) { return provider.Degrade(depth, k); });
+    EXPECT_GT(with_network.run.tracked, 50) << "localize_only " << localize_only;
     // Measured: 1.045 extending the map, 1.068 localising only (the anchor's tolerance); the
     // map's own units read 3.83.
-    EXPECT_NEAR(ate.gt_from_est.scale, 1 / 0.9, 0.1) << "localize_only " << localize_only;
+    EXPECT_NEAR(Ate(with_network.run, Alignment::kSim3).gt_from_est.scale, 1 / 0.9, 0.1)
+        << "localize_only " << localize_only;
   }
   std::filesystem::remove_all(dir);
 }

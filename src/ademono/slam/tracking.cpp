@@ -482,21 +482,26 @@ void Tracking::CorrectDepthScale(Frame& frame, bool inliers_only) {
   if (!frame.F().DepthIsPrior() || !options_.depth.scale_correction || !frame.cam_from_world) {
     return;
   }
-  const FrameFeatures& f = frame.F();
   std::vector<double> map_depths, frame_depths;
-  for (size_t i = 0; i < frame.map_points.size(); ++i) {
-    const auto& p = frame.map_points[i];
-    if (!p || p->bad || !UsableForPose(*p) || !(f.depth[i] > 0) ||
-        (inliers_only && frame.outlier[i]))
-      continue;
-    map_depths.push_back((*frame.cam_from_world * p->position).z());
-    frame_depths.push_back(f.depth[i]);
-  }
+  DepthPairs(frame, frame.F(), inliers_only, &map_depths, &frame_depths);
   DepthScaleOptions options;
   options.min_points = options_.depth.scale_min_points;
   const DepthScaleEstimate estimate = EstimateDepthScale(map_depths, frame_depths, options);
   if (!estimate.valid) return;
-  frame.features = RescaleDepth(f, static_cast<float>(estimate.scale));
+  frame.features = RescaleDepth(frame.F(), static_cast<float>(estimate.scale));
+}
+
+void Tracking::DepthPairs(const Frame& frame, const FrameFeatures& features, bool inliers_only,
+                          std::vector<double>* map_depths,
+                          std::vector<double>* feature_depths) const {
+  for (size_t i = 0; i < frame.map_points.size() && i < features.depth.size(); ++i) {
+    const auto& p = frame.map_points[i];
+    if (!p || p->bad || !UsableForPose(*p) || !(features.depth[i] > 0) ||
+        (inliers_only && frame.outlier[i]))
+      continue;
+    map_depths->push_back((*frame.cam_from_world * p->position).z());
+    feature_depths->push_back(features.depth[i]);
+  }
 }
 
 void Tracking::AnchorScale(Frame& frame) {
@@ -643,16 +648,16 @@ Rigid3d ResolveFramePose(const FrameRecord& record) {
 
 std::optional<double> Tracking::SensorToMapScale(const FrameFeatures& with_depth) const {
   if (!last_frame_ || !last_frame_->cam_from_world) return std::nullopt;
-  const Frame& frame = *last_frame_;
-  std::vector<double> ratios;
-  for (size_t i = 0; i < frame.map_points.size() && i < with_depth.depth.size(); ++i) {
-    const auto& p = frame.map_points[i];
-    if (!p || p->bad || !(with_depth.depth[i] > 0)) continue;
-    const double z = (*frame.cam_from_world * p->position).z();
-    if (z > 0) ratios.push_back(with_depth.depth[i] / z);
-  }
-  if (ratios.size() < kMinSensorScaleSamples) return std::nullopt;
-  return Median(ratios);
+  std::vector<double> map_depths, sensor_depths;
+  DepthPairs(*last_frame_, with_depth, false, &map_depths, &sensor_depths);
+  // The median ratio (no Huber steps): one frame, tracked without these depths, so nothing in
+  // it was fitted to them.
+  DepthScaleOptions options;
+  options.min_points = static_cast<int>(kMinSensorScaleSamples);
+  options.iterations = 0;
+  const DepthScaleEstimate estimate = EstimateDepthScale(sensor_depths, map_depths, options);
+  if (!estimate.valid) return std::nullopt;
+  return estimate.scale;
 }
 
 void Tracking::GiveLoadedMapScale(double factor) {

@@ -213,6 +213,11 @@ class Tracking {
   // Network depth: rescales the frame's depths to agree with the map points it tracks (robust
   // median of ratios); `inliers_only` after the pose is final.
   void CorrectDepthScale(Frame& frame, bool inliers_only) ADEMONO_REQUIRES(map_.mutex);
+  // The depths of `frame`'s map points in its camera (map units) beside `features`' depths of the
+  // same keypoints, where both are known (`inliers_only`: the frame's outliers left out).
+  void DepthPairs(const Frame& frame, const FrameFeatures& features, bool inliers_only,
+                  std::vector<double>* map_depths, std::vector<double>* feature_depths) const
+      ADEMONO_REQUIRES(map_.mutex);
   // Keeps the map at the network's long-run mean scale, or with depth.camera_height at the scale
   // that puts the camera camera_height above the ground (rescales the world when it drifted).
   void AnchorScale(Frame& frame) ADEMONO_REQUIRES(map_.mutex);
