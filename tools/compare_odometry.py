@@ -82,8 +82,9 @@ def read_pose(path):
     return m
 
 
-# --depth-dir: depth maps from elsewhere (e.g. `ademono infer`'s network depth cache, 16-bit mm
-# PNGs named after the colour image) fed to every method as if they were the sensor's.
+# --depth-dir: depth maps from elsewhere (e.g. `ademono infer --depth-format png`'s network depth
+# cache, 16-bit mm PNGs named after the colour image) fed to every method as if they were the
+# sensor's.
 DEPTH_DIR = None
 
 
@@ -273,7 +274,8 @@ def main():
                         help="an extra TUM trajectory to score in the same table (repeatable)")
     parser.add_argument("--json", help="also write the table as JSON here")
     parser.add_argument("--depth-dir", help="depth maps to use instead of the sensor's "
-                        "(`ademono infer` cache: DIR/frame-XXXXXX.color.png, 16-bit mm)")
+                        "(`ademono infer --depth-format png` cache: DIR/frame-XXXXXX.color.png, "
+                        "16-bit mm)")
     parser.add_argument("--reuse", action="store_true",
                         help="re-score trajectories already in --out from an identical run "
                              "(same sequence, frames, stride) instead of recomputing them")

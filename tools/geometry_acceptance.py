@@ -22,7 +22,8 @@ run tracked (the "<= 1.1x none" criterion) with `ademono eval`. Every row with d
 RGB-D family `run` picks); on the office it is scored on the none run's frames: the geometric
 mode must be within 1.5x of it. --cache replays `ademono infer`
 caches (made once under OUT/cache) instead of running the networks: faster, the same settings
-family and error model, depths rounded to the cache's millimetres. --ablation adds the variants of
+family and error model, the networks' depths to the bit (float TIFF): the same runs as without
+--cache. --ablation adds the variants of
 the new design on seq-a and KITTI (docs/slam.md "Ablation"). --speed adds the issue's speed
 checks on seq-a, run alone after the table: sensor depth and `--depth none` interleaved three
 times each (median frames/s; none must be at least as fast), and FastDepth + YOLOX-nano run

@@ -15,7 +15,7 @@
    network's, per depth band, and after each frame's own median scale (what SLAM's per-frame
    scale correction removes).
 
-The network's depth comes from an `ademono infer` cache (DIR/<frame name>.png, uint16 mm):
+The network's depth comes from an `ademono infer` cache (DIR/<frame name>.tiff, float32 m, or .png, uint16 mm):
 
   build/release/bin/ademono infer --dataset kitti:../shared/data/kitti-00/sequences/00 \\
       --depth-model model:../shared/models/pydnet_kitti.onnx,spec=configs/models/pydnet_kitti.yaml \\
@@ -188,14 +188,20 @@ def main():
     images, depths = [], []
     for path in image_paths:
         name = os.path.splitext(os.path.basename(path))[0]
-        dpath = os.path.join(args.depth, name + ".png")
-        if not os.path.isfile(dpath):
-            fail(f"{dpath}: missing depth for frame {name}")
+        # `infer` writes float32 metres (.tiff) or, with --depth-format png, uint16 millimetres.
+        dpath = next((os.path.join(args.depth, name + ext) for ext in (".tiff", ".png")
+                      if os.path.isfile(os.path.join(args.depth, name + ext))), None)
+        if dpath is None:
+            fail(f"{os.path.join(args.depth, name)}.tiff: missing depth for frame {name}")
         images.append(cv2.imread(path, cv2.IMREAD_COLOR))
         d = cv2.imread(dpath, cv2.IMREAD_UNCHANGED)
-        if d is None or d.dtype != np.uint16:
-            fail(f"{dpath}: not a uint16 PNG")
-        depths.append(d.astype(np.float64) / 1000.0)
+        if d is not None and d.dtype == np.float32:
+            d = np.where(np.isfinite(d) & (d > 0), d, 0.0).astype(np.float64)
+        elif d is not None and d.dtype == np.uint16:
+            d = d.astype(np.float64) / 1000.0
+        else:
+            fail(f"{dpath}: neither a float32 TIFF (m) nor a uint16 PNG (mm)")
+        depths.append(d)
 
     report = {"frames": len(images), "height_m": args.height}
     start, end, step = (int(x) for x in args.rows.split(":"))

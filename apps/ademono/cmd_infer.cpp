@@ -1,6 +1,9 @@
 // `ademono infer`: run the depth model and/or the detector over a dataset once and cache the
 // results, so `--depth cache:DIR/depth` and `--detector cache:DIR/detections.jsonl` replay them:
-//   DIR/depth/<frame name>.png   uint16 millimetres, 0 = invalid
+//   DIR/depth/<frame name>.tiff  float32 metres as the network gave them (--depth-format tiff, the
+//                                default: a replay reproduces a run with the network to the bit)
+//   DIR/depth/<frame name>.png   uint16 millimetres, 0 = invalid (--depth-format png: what TUM-style
+//                                tools read; rounding to the millimetre moves a run's figures)
 //   DIR/detections.jsonl         detections per frame (perception/detection_io.h)
 // Everything is written into a staging folder beside DIR and moved into place at the end, so a
 // failed run leaves no partial cache.
@@ -36,6 +39,7 @@ struct InferArgs {
   float score = 0.3f;
   float nms = 0.45f;
   int threads = 1;
+  std::string depth_format = "tiff";
   std::string out;
 };
 
@@ -128,7 +132,7 @@ int RunInfer(const InferArgs& args) {
       const cv::Mat map = depth->Depth(frame, sequence->GetCamera());
       depth_ms +=
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      ademono::WriteDepthMap(staging.Path() / "depth" / (frame.name + ".png"), map);
+      ademono::WriteDepthMap(staging.Path() / "depth" / (frame.name + "." + args.depth_format), map);
     }
     if (detector) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -186,6 +190,10 @@ const bool kRegistered = ademono::cli::RegisterCommand(
       app.add_option("--score", args->score, "detector score threshold")->capture_default_str();
       app.add_option("--nms", args->nms, "detector NMS IoU threshold")->capture_default_str();
       app.add_option("--threads", args->threads, "ONNX Runtime intra-op threads")
+          ->capture_default_str();
+      app.add_option("--depth-format", args->depth_format,
+                     "tiff: float32 metres, exact; png: uint16 millimetres")
+          ->check(CLI::IsMember({"tiff", "png"}))
           ->capture_default_str();
       app.add_option("--out", args->out, "output directory")->required();
       return [args] { return RunInfer(*args); };

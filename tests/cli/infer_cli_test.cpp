@@ -45,12 +45,47 @@ TEST(InferCliTest, CachesReadBackThroughCacheProviders) {
     const cv::Mat expected = model.Depth(frame, sequence->GetCamera());
     const cv::Mat actual = cached->Depth(frame, sequence->GetCamera());
     ASSERT_EQ(actual.size(), expected.size());
-    EXPECT_LE(cv::norm(actual, expected, cv::NORM_INF), 0.0005 + 1e-6);  // millimetre rounding
+    // float32 metres: the replay is the network's depth to the bit.
+    EXPECT_EQ(cv::norm(actual, expected, cv::NORM_INF), 0.0);
     const auto boxes = detections->Detect(frame);
     ASSERT_EQ(boxes.size(), 2u);  // the constant head's two boxes
     EXPECT_EQ(boxes[0].class_id, 1);
   }
   EXPECT_EQ(std::distance(fs::directory_iterator(out / "depth"), fs::directory_iterator()), 3);
+  EXPECT_TRUE(fs::exists(out / "depth" / (sequence->Load(2).name + ".tiff")));
+  fs::remove_all(dir);
+}
+
+TEST(InferCliTest, PngDepthIsMillimetres) {
+  if (!fs::exists(kSevenScenes)) GTEST_SKIP() << "no " << kSevenScenes;
+  const fs::path dir = FreshTempDir("infer_cli_png");
+  const fs::path out = dir / "cache";
+  const std::string dataset = "7scenes:" + kSevenScenes.string();
+  const CliResult r = RunCli("infer --dataset " + dataset + " --frames 2:4 --depth-model model:" +
+                             (kModels / "depth_metric.onnx").string() +
+                             " --depth-format png --out " + out.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  auto sequence = ademono::OpenSequence(dataset);
+  ademono::DepthFactoryContext context;
+  context.sequence = sequence.get();
+  auto cached = ademono::MakeDepthProvider("cache:" + (out / "depth").string(), context);
+  ademono::OnnxDepthProvider model(kModels / "depth_metric.onnx", {}, {});
+  for (size_t i = 2; i < 4; ++i) {
+    const ademono::FrameData frame = sequence->Load(i);
+    EXPECT_TRUE(fs::exists(out / "depth" / (frame.name + ".png")));
+    const cv::Mat expected = model.Depth(frame, sequence->GetCamera());
+    const cv::Mat actual = cached->Depth(frame, sequence->GetCamera());
+    ASSERT_EQ(actual.size(), expected.size());
+    const double error = cv::norm(actual, expected, cv::NORM_INF);
+    EXPECT_LE(error, 0.0005 + 1e-6);  // millimetre rounding
+    EXPECT_GT(error, 0.0);
+  }
+  const CliResult bad = RunCli("infer --dataset " + dataset + " --frames 2:4 --depth-model model:" +
+                               (kModels / "depth_metric.onnx").string() +
+                               " --depth-format jpg --out " + (dir / "bad").string());
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_THAT(bad.out, testing::HasSubstr("--depth-format"));
+  EXPECT_FALSE(fs::exists(dir / "bad"));
   fs::remove_all(dir);
 }
 

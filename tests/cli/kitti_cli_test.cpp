@@ -30,7 +30,7 @@ TEST(KittiCliTest, InferRunAndGroundOnTheRealDrive) {
                        " --out " + (dir / "cache").string());
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_THAT(r.out, testing::HasSubstr("12 frames (0..11)"));
-  EXPECT_TRUE(fs::exists(dir / "cache/depth/000011.png"));
+  EXPECT_TRUE(fs::exists(dir / "cache/depth/000011.tiff"));
 
   const std::string depth = " --depth cache:" + (dir / "cache/depth").string();
   r = RunCli("run --dataset " + kDataset + " --frames 0:12" + depth + " --out " +
