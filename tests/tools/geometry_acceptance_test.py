@@ -91,6 +91,18 @@ def test_a_geometric_run_that_never_initialised_compares_nothing():
     assert ok
 
 
+def test_no_draw_with_a_geometric_run_leaves_the_ratio_out():
+    never = dict(row("bonn_late", "none", 0.0, tracked=0, frames=0), sim3=None, se3=None,
+                 scale=None, tracked_from_init=None, never_initialised=True)
+    tables = {s: [dict(never), row("bonn_late", "network", 0.019, tracked=232, frames=232)]
+              for s in (42, 1)}
+    out, ok = ga.draws_table(tables)
+    network = [r for r in out if r["depth"] == "network"][0]
+    assert network["vs_none"] is None and network["met"] and ok
+    none = [r for r in out if r["depth"] == "none"][0]
+    assert none["sim3"] is None and none["never_initialised"]
+
+
 @pytest.mark.parametrize("args, message", [
     (["--seed", "1", "--seeds", "1,2"], "--seed and --seeds exclude each other"),
     (["--seeds", "1,x"], "--seeds: a comma-separated list of integers"),
