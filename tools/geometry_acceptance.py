@@ -503,8 +503,6 @@ def main():
                 (r, "network_prior", ["--config", prior_cfg]),
                 (r, "no_priors", ["--set", "mapping.network_priors=false"]),
                 (r, "no_error_model", ["--set", "mapping.network_error_model=false"]),
-                # Each prior's error as its own, none of it shared with the keyframe's others.
-                (r, "independent_priors", ["--set", "mapping.network_shared_error=false"]),
                 (r, "no_scale_anchor", ["--set", "depth.anchor_scale=false",
                                         "--set", "depth.camera_height=0"]),
                 (r, "two_view_start", ["--set", "tracking.min_init_points=100000"]),

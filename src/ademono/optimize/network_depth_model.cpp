@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "ademono/core/statistics.h"
 
@@ -14,6 +16,28 @@ double Quantile(std::vector<double> v, double q) {
   const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
   std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
   return v[k];
+}
+
+// The rms of the depth bins' median residuals beyond their sampling noise (a median of n
+// samples of spread s scatters by about s * sqrt(pi / (2 n))).
+double SharedSpread(std::vector<std::pair<double, double>> by_depth,
+                    const InverseDepthAffineOptions& options) {
+  const size_t bins = static_cast<size_t>(std::max(1, options.depth_bins));
+  const size_t per_bin = by_depth.size() / bins;
+  if (bins < 2 || per_bin < static_cast<size_t>(std::max(2, options.min_points_per_bin)))
+    return 0.0;
+  std::sort(by_depth.begin(), by_depth.end());
+  double sum = 0.0;
+  for (size_t b = 0; b < bins; ++b) {
+    const size_t end = b + 1 == bins ? by_depth.size() : (b + 1) * per_bin;
+    std::vector<double> r;
+    for (size_t i = b * per_bin; i < end; ++i) r.push_back(by_depth[i].second);
+    const double median = Median(r);
+    const double spread = RobustSpread(r, median);
+    const double noise = spread * spread * M_PI / (2.0 * static_cast<double>(r.size()));
+    sum += std::max(0.0, median * median - noise);
+  }
+  return std::sqrt(sum / static_cast<double>(bins));
 }
 
 }  // namespace
@@ -86,14 +110,19 @@ InverseDepthAffine FitInverseDepthAffine(const std::vector<double>& map_depths,
   if (!(fit.a > 0) || !std::isfinite(fit.a) || !std::isfinite(fit.b)) return fit;
   // The spread of the points the fit kept (within 3 robust sigmas).
   std::vector<double> log_residuals;
+  std::vector<std::pair<double, double>> by_depth;  // (z_net, log residual) of the inliers
   const double sigma = RobustSpread(residuals);
   for (size_t i = 0; i < n; ++i) {
     if (std::abs(residuals[i]) > 3.0 * sigma) continue;
     ++fit.num_inliers;
     const double mapped = fit.Map(zn[i]);
-    if (mapped > 0) log_residuals.push_back(std::log(zm[i] / mapped));
+    if (mapped > 0) {
+      log_residuals.push_back(std::log(zm[i] / mapped));
+      by_depth.emplace_back(zn[i], log_residuals.back());
+    }
   }
   fit.sigma_log = RobustSpread(log_residuals);
+  fit.shared_sigma_log = SharedSpread(by_depth, options);
   fit.valid = true;
   return fit;
 }

@@ -29,6 +29,12 @@ struct InverseDepthAffine {
   // Robust spread (1.4826 MAD) of log(z_map / Map(z_net)) over the inliers: the network's
   // per-point error left after the affine map.
   double sigma_log = 0.0;
+  // What of that spread the view's points share: the rms over depth bins (equal counts, by the
+  // network's depth) of each bin's median log residual, less what the medians' own sampling
+  // noise explains. The affine map leaves it where the network's error depends on depth in a way
+  // the map cannot follow (a road read ever shorter with distance); it is 0 for independent
+  // per-point noise. n priors in one view then hold the shared part as one observation, not n.
+  double shared_sigma_log = 0.0;
   // Robust scale of the network against the map: the median of z_net / z_map.
   double median_ratio = 1.0;
 
@@ -52,6 +58,8 @@ struct InverseDepthAffineOptions {
   // b is fitted only when the inverse depths span at least this ratio (max / min over the 10th
   // to 90th percentile); else scale only.
   double min_inverse_depth_span = 1.5;
+  int depth_bins = 3;            // for shared_sigma_log
+  int min_points_per_bin = 10;   // fewer: shared_sigma_log stays 0
 };
 
 // `map_depths[i]` and `network_depths[i]` are one point's depth in the view as the map has it and

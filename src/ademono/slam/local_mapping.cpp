@@ -442,6 +442,17 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         for (const auto& [kf, n] : depths) scale_prior_sigma[kf] = *spread * std::sqrt(n);
       }
     }
+    // How many of each keyframe's network priors enter this solve (their shared error counts once).
+    std::map<const KeyFrame*, int> priors_in_view;
+    if (monocular_ && options_.network_priors) {
+      for (MapPoint* p : local_points) {
+        if (!p->depth_prior || p->reference == nullptr) continue;
+        const auto obs = p->observations.find(p->reference);
+        if (obs != p->observations.end() && camera_index.count(obs->first) != 0 &&
+            obs->first->F().depth[obs->second] > 0 && PriorActive(*p))
+          ++priors_in_view[obs->first];
+      }
+    }
     for (MapPoint* p : local_points) {
       const size_t point_index = problem.points.size();
       if (any_ground) point_index_of[p->id] = point_index;
@@ -454,7 +465,8 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         // The network's depth holds the point only where geometry cannot yet.
         const bool prior = monocular_ && options_.network_priors && p->depth_prior &&
                            kf == p->reference && kf->F().depth[idx] > 0 && PriorActive(*p);
-        ImageObservation observation = prior ? NetworkPrior(*kf, idx) : kf->F().Observation(idx);
+        ImageObservation observation =
+            prior ? NetworkPrior(*kf, idx, priors_in_view[kf]) : kf->F().Observation(idx);
         const auto scale_prior = scale_prior_sigma.find(kf);
         if (!prior && scale_prior != scale_prior_sigma.end() && kf->F().depth[idx] > 0) {
           // The network's own reading: the anchor holds the map at its long-run scale.
@@ -533,7 +545,8 @@ void LocalMapping::CullKeyFrames(KeyFrame& keyframe) {
   }
 }
 
-ImageObservation LocalMapping::NetworkPrior(const KeyFrame& kf, size_t i) const {
+ImageObservation LocalMapping::NetworkPrior(const KeyFrame& kf, size_t i,
+                                            int priors_in_view) const {
   const FrameFeatures& f = kf.F();
   double z = f.depth[i];
   // The keyframe's own error model once it has one: the network's reading mapped into the map.
@@ -541,7 +554,22 @@ ImageObservation LocalMapping::NetworkPrior(const KeyFrame& kf, size_t i) const 
     const double mapped = kf.network_fit.Map(f.depth[i] / f.depth_scale);
     if (mapped > 0) z = mapped;
   }
-  return f.PriorObservation(i, z, NetworkSigmaLog() * z);
+  const double independent = NetworkSigmaLog(), shared = NetworkSharedSigmaLog();
+  const double sigma_log =
+      shared > 0 ? std::sqrt(independent * independent +
+                             std::max(1, priors_in_view) * shared * shared)
+                 : independent;
+  return f.PriorObservation(i, z, sigma_log * z);
+}
+
+double LocalMapping::NetworkSharedSigmaLog() const {
+  if (shared_sigma_logs_.empty() || !options_.network_error_model ||
+      !options_.network_shared_error)
+    return 0.0;
+  constexpr size_t kRecent = 20;  // as NetworkSigmaLog
+  const size_t start = shared_sigma_logs_.size() > kRecent ? shared_sigma_logs_.size() - kRecent : 0;
+  return Median(std::vector<double>(shared_sigma_logs_.begin() + static_cast<long>(start),
+                                    shared_sigma_logs_.end()));
 }
 
 double LocalMapping::NetworkSigmaLog() const {
@@ -605,8 +633,11 @@ void LocalMapping::MeasureNetworkErrors(const Pending& pending) {
     kf.network_fit = fit;
     if (&kf == pending.keyframe.get()) {
       sigma_logs_.push_back(fit.sigma_log);
-      spdlog::debug("keyframe {}: network error after its affine map {:.3f} (log, {} points)",
-                    kf.id, fit.sigma_log, map_depths.size());
+      shared_sigma_logs_.push_back(fit.shared_sigma_log);
+      spdlog::debug(
+          "keyframe {}: network error after its affine map {:.3f} (log, {} points), shared "
+          "{:.3f}",
+          kf.id, fit.sigma_log, map_depths.size(), fit.shared_sigma_log);
     }
   }
 }

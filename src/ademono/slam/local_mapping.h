@@ -66,9 +66,15 @@ class LocalMapping {
   // after each keyframe's affine map, InverseDepthAffine::sigma_log) measured so far against
   // triangulated points, or the configured error model's until there is a measurement.
   double NetworkSigmaLog() const;
+  // The part of that error a view's points share (InverseDepthAffine::shared_sigma_log, recent
+  // keyframes' median; 0 until measured or with mapping.network_shared_error off).
+  double NetworkSharedSigmaLog() const;
   // Monocular core with a network: keypoint i of `kf` with its network depth as a prior
-  // observation (the keyframe's fitted error model applied when it has one).
-  ImageObservation NetworkPrior(const KeyFrame& kf, size_t i) const ADEMONO_REQUIRES(map_.mutex);
+  // observation (the keyframe's fitted error model applied when it has one). `priors_in_view`:
+  // how many of kf's priors enter the same solve; their shared error counts once among them
+  // (relative sigma sqrt(sigma_log^2 + n * shared^2)).
+  ImageObservation NetworkPrior(const KeyFrame& kf, size_t i, int priors_in_view = 1) const
+      ADEMONO_REQUIRES(map_.mutex);
   // Monocular core with a network: whether point `p`'s network-depth prior still enters local BA
   // (geometry's depth of it less certain than the network's: too little parallax).
   bool PriorActive(const MapPoint& p) const ADEMONO_REQUIRES(map_.mutex);
@@ -117,6 +123,7 @@ class LocalMapping {
   bool monocular_ = false;
   double configured_sigma_log_ = 0.0;  // the options' error model, until measured
   std::vector<double> sigma_logs_;     // per fitted keyframe (tracking thread)
+  std::vector<double> shared_sigma_logs_;  // the same fits' shared part
   std::vector<std::shared_ptr<MapPoint>> recent_points_;
   LoopClosing* loop_closing_ = nullptr;
   std::unique_ptr<Pending> pending_;  // tracking thread only, apart from the solve below

@@ -142,6 +142,7 @@ const OptionsTable<MappingOptions>& MappingOptions::Table() {
           .Add("triangulation_depth_sigmas", &M::triangulation_depth_sigmas, Range::AtLeast(0))
           .Add("network_priors", &M::network_priors)
           .Add("network_error_model", &M::network_error_model)
+          .Add("network_shared_error", &M::network_shared_error)
           .Add("network_scale_prior", &M::network_scale_prior)
           .Add("triangulation_match_ratio", &M::triangulation_match_ratio,
                Range::OpenClosed(0, 1))

@@ -242,6 +242,14 @@ struct MappingOptions {
   // configured error model (network_error_model). Off: the ablation of each.
   bool network_priors = true;
   bool network_error_model = true;
+  // The measured error's part a keyframe's points share (InverseDepthAffine::shared_sigma_log:
+  // a depth-dependent bias the affine map leaves) held as one observation among that keyframe's
+  // n priors in a solve, not n: each prior's relative sigma sqrt(sigma^2 + n * shared^2), as
+  // network_scale_prior does with the scale. Off in both families: over four draws of every
+  // development row it helped KITTI (`kitti_late` 1.15x -> 1.10x `none`) and seq-a from frame 400
+  // (se3 0.0787 -> 0.0679 m) but cost Bonn (0.0142 -> 0.0157 m; `bonn_late` 0.0186 -> 0.0346 m at
+  // scale 0.85), the office and the street (docs/slam.md "Tried 2026-12-03 (evening)").
+  bool network_shared_error = false;
   // The network's scale per keyframe in local BA: every network depth of a free keyframe enters
   // as a prior whose sigma is the keyframe scale's measured spread (robust, over the map's
   // keyframes) times sqrt(n) of its n depths, so together they hold the keyframe's scale as one
