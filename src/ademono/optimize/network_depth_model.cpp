@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -34,7 +35,7 @@ double SharedSpread(std::vector<std::pair<double, double>> by_depth,
     for (size_t i = b * per_bin; i < end; ++i) r.push_back(by_depth[i].second);
     const double median = Median(r);
     const double spread = RobustSpread(r, median);
-    const double noise = spread * spread * M_PI / (2.0 * static_cast<double>(r.size()));
+    const double noise = spread * spread * std::numbers::pi / (2.0 * static_cast<double>(r.size()));
     sum += std::max(0.0, median * median - noise);
   }
   return std::sqrt(sum / static_cast<double>(bins));

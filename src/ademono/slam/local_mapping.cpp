@@ -42,6 +42,12 @@ LocalMapping::~LocalMapping() {
 }
 
 namespace {
+
+int InViewCount(const std::map<const KeyFrame*, int>& counts, const KeyFrame* kf) {
+  const auto it = counts.find(kf);
+  return it == counts.end() ? 1 : it->second;
+}
+
 double MsSinceStart(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -444,7 +450,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
     }
     // How many of each keyframe's network priors enter this solve (their shared error counts once).
     std::map<const KeyFrame*, int> priors_in_view;
-    if (monocular_ && options_.network_priors) {
+    if (monocular_ && options_.network_priors && NetworkSharedSigmaLog() > 0) {
       for (MapPoint* p : local_points) {
         if (!p->depth_prior || p->reference == nullptr) continue;
         const auto obs = p->observations.find(p->reference);
@@ -466,7 +472,8 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
         const bool prior = monocular_ && options_.network_priors && p->depth_prior &&
                            kf == p->reference && kf->F().depth[idx] > 0 && PriorActive(*p);
         ImageObservation observation =
-            prior ? NetworkPrior(*kf, idx, priors_in_view[kf]) : kf->F().Observation(idx);
+            prior ? NetworkPrior(*kf, idx, InViewCount(priors_in_view, kf))
+                  : kf->F().Observation(idx);
         const auto scale_prior = scale_prior_sigma.find(kf);
         if (!prior && scale_prior != scale_prior_sigma.end() && kf->F().depth[idx] > 0) {
           // The network's own reading: the anchor holds the map at its long-run scale.
@@ -567,7 +574,8 @@ double LocalMapping::NetworkSharedSigmaLog() const {
       !options_.network_shared_error)
     return 0.0;
   constexpr size_t kRecent = 20;  // as NetworkSigmaLog
-  const size_t start = shared_sigma_logs_.size() > kRecent ? shared_sigma_logs_.size() - kRecent : 0;
+  const size_t start =
+      shared_sigma_logs_.size() > kRecent ? shared_sigma_logs_.size() - kRecent : 0;
   return Median(std::vector<double>(shared_sigma_logs_.begin() + static_cast<long>(start),
                                     shared_sigma_logs_.end()));
 }
