@@ -43,6 +43,13 @@ LocalMapping::~LocalMapping() {
 
 namespace {
 
+// The median of the last fits' values (the network's error depends on the scene it sees).
+double RecentMedian(const std::vector<double>& per_fit) {
+  constexpr size_t kRecent = 20;
+  const size_t start = per_fit.size() > kRecent ? per_fit.size() - kRecent : 0;
+  return Median(std::vector<double>(per_fit.begin() + static_cast<long>(start), per_fit.end()));
+}
+
 int InViewCount(const std::map<const KeyFrame*, int>& counts, const KeyFrame* kf) {
   const auto it = counts.find(kf);
   return it == counts.end() ? 1 : it->second;
@@ -449,13 +456,18 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       }
     }
     // How many of each keyframe's network priors enter this solve (their shared error counts once).
+    // The network's depth holds the point only where geometry cannot yet.
+    const auto is_prior = [&](const MapPoint& p, const KeyFrame* kf, size_t idx) {
+      return monocular_ && options_.network_priors && p.depth_prior && kf == p.reference &&
+             kf->F().depth[idx] > 0 && PriorActive(p);
+    };
     std::map<const KeyFrame*, int> priors_in_view;
-    if (monocular_ && options_.network_priors && NetworkSharedSigmaLog() > 0) {
+    if (NetworkSharedSigmaLog() > 0) {
       for (MapPoint* p : local_points) {
         if (!p->depth_prior || p->reference == nullptr) continue;
         const auto obs = p->observations.find(p->reference);
         if (obs != p->observations.end() && camera_index.count(obs->first) != 0 &&
-            obs->first->F().depth[obs->second] > 0 && PriorActive(*p))
+            is_prior(*p, obs->first, obs->second))
           ++priors_in_view[obs->first];
       }
     }
@@ -468,9 +480,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       for (const auto& [kf, idx] : p->observations) {
         auto it = camera_index.find(kf);
         if (it == camera_index.end()) continue;
-        // The network's depth holds the point only where geometry cannot yet.
-        const bool prior = monocular_ && options_.network_priors && p->depth_prior &&
-                           kf == p->reference && kf->F().depth[idx] > 0 && PriorActive(*p);
+        const bool prior = is_prior(*p, kf, idx);
         ImageObservation observation =
             prior ? NetworkPrior(*kf, idx, InViewCount(priors_in_view, kf))
                   : kf->F().Observation(idx);
@@ -573,20 +583,12 @@ double LocalMapping::NetworkSharedSigmaLog() const {
   if (shared_sigma_logs_.empty() || !options_.network_error_model ||
       !options_.network_shared_error)
     return 0.0;
-  constexpr size_t kRecent = 20;  // as NetworkSigmaLog
-  const size_t start =
-      shared_sigma_logs_.size() > kRecent ? shared_sigma_logs_.size() - kRecent : 0;
-  return Median(std::vector<double>(shared_sigma_logs_.begin() + static_cast<long>(start),
-                                    shared_sigma_logs_.end()));
+  return RecentMedian(shared_sigma_logs_);
 }
 
 double LocalMapping::NetworkSigmaLog() const {
   if (sigma_logs_.empty() || !options_.network_error_model) return configured_sigma_log_;
-  // The recent keyframes' (the network's error depends on the scene it sees).
-  constexpr size_t kRecent = 20;
-  const size_t start = sigma_logs_.size() > kRecent ? sigma_logs_.size() - kRecent : 0;
-  return Median(
-      std::vector<double>(sigma_logs_.begin() + static_cast<long>(start), sigma_logs_.end()));
+  return RecentMedian(sigma_logs_);
 }
 
 std::optional<double> LocalMapping::KeyFrameScaleSpread() const {
