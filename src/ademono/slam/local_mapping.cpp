@@ -456,18 +456,13 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       }
     }
     // How many of each keyframe's network priors enter this solve (their shared error counts once).
-    // The network's depth holds the point only where geometry cannot yet.
-    const auto is_prior = [&](const MapPoint& p, const KeyFrame* kf, size_t idx) {
-      return monocular_ && options_.network_priors && p.depth_prior && kf == p.reference &&
-             kf->F().depth[idx] > 0 && PriorActive(p);
-    };
     std::map<const KeyFrame*, int> priors_in_view;
     if (NetworkSharedSigmaLog() > 0) {
       for (MapPoint* p : local_points) {
         if (!p->depth_prior || p->reference == nullptr) continue;
         const auto obs = p->observations.find(p->reference);
         if (obs != p->observations.end() && camera_index.count(obs->first) != 0 &&
-            is_prior(*p, obs->first, obs->second))
+            IsNetworkPrior(*p, *obs->first, obs->second))
           ++priors_in_view[obs->first];
       }
     }
@@ -480,7 +475,7 @@ bool LocalMapping::GatherBundleAdjustment(KeyFrame& keyframe, Pending& pending) 
       for (const auto& [kf, idx] : p->observations) {
         auto it = camera_index.find(kf);
         if (it == camera_index.end()) continue;
-        const bool prior = is_prior(*p, kf, idx);
+        const bool prior = IsNetworkPrior(*p, *kf, idx);
         ImageObservation observation =
             prior ? NetworkPrior(*kf, idx, InViewCount(priors_in_view, kf))
                   : kf->F().Observation(idx);
@@ -601,6 +596,12 @@ std::optional<double> LocalMapping::KeyFrameScaleSpread() const {
   const double spread = RobustSpread(logs, Median(logs));
   if (!(spread > 0)) return std::nullopt;
   return spread;
+}
+
+bool LocalMapping::IsNetworkPrior(const MapPoint& p, const KeyFrame& kf, size_t i) const {
+  // The network's depth holds the point only where geometry cannot yet.
+  return monocular_ && options_.network_priors && p.depth_prior && &kf == p.reference &&
+         kf.F().depth[i] > 0 && PriorActive(p);
 }
 
 bool LocalMapping::PriorActive(const MapPoint& p) const {

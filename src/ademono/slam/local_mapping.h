@@ -78,6 +78,9 @@ class LocalMapping {
   // Monocular core with a network: whether point `p`'s network-depth prior still enters local BA
   // (geometry's depth of it less certain than the network's: too little parallax).
   bool PriorActive(const MapPoint& p) const ADEMONO_REQUIRES(map_.mutex);
+  // Whether keyframe `kf`'s observation i of `p` enters local BA as the network's depth prior.
+  bool IsNetworkPrior(const MapPoint& p, const KeyFrame& kf, size_t i) const
+      ADEMONO_REQUIRES(map_.mutex);
   // Monocular core with a network: the robust spread (1.4826 MAD) of the map's keyframes' log
   // depth scales (network against map), or nullopt with fewer than 5 keyframes to measure it.
   std::optional<double> KeyFrameScaleSpread() const ADEMONO_REQUIRES(map_.mutex);
